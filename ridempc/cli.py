@@ -1,0 +1,128 @@
+"""The ``ridempc`` command: ``sim`` runs a ride, ``list`` names what exists.
+
+Bad input exits with code 2 and one line on standard error naming the bad value and the
+valid ones; a run that fails (diverged physics, a controller error) exits with code 1
+after recording ``status: failed`` in its ``summary.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from ridempc.errors import ConfigError, RidempcError, UnknownNameError
+
+__all__ = ["main"]
+
+EXIT_FAILED = 1
+EXIT_BAD_INPUT = 2
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="ridempc", description="Legged robots riding boards in MuJoCo."
+    )
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    sim = commands.add_parser("sim", help="run one ride and write its results to --out")
+    sim.add_argument("--robot", default="cassie", help="robot name (default: cassie)")
+    sim.add_argument("--board", default="none", help="board name, 'none' = flat ground")
+    sim.add_argument("--controller", default="stand", help="controller name (default: stand)")
+    sim.add_argument("--scenario", default="stand-still", help="scenario name or .toml file")
+    sim.add_argument("--duration", type=float, default=None, help="override duration [s]")
+    sim.add_argument("--out", type=Path, required=True, help="output folder")
+    sim.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    sim.add_argument("--video", action="store_true", help="render video.mp4 offscreen")
+    sim.add_argument("--no-plots", action="store_true", help="do not write plots.png")
+    sim.add_argument("--viewer", action="store_true", help="open MuJoCo's interactive viewer")
+    sim.add_argument(
+        "--ground-truth", action="store_true",
+        help="debugging only: put ground truth in the sensor packets (flagged in the summary)",
+    )
+
+    commands.add_parser("list", help="name the robots, boards, controllers and scenarios")
+    return parser
+
+
+def _list() -> int:
+    from ridempc.boards import board_names
+    from ridempc.controllers import controller_names
+    from ridempc.robots import robot_names
+    from ridempc.scenarios import resolve_scenario, scenario_names
+
+    print("robots:      " + ", ".join(robot_names()))
+    print("boards:      " + ", ".join(board_names()))
+    print("controllers: " + ", ".join(controller_names()))
+    print("scenarios:")
+    for name in scenario_names():
+        scenario = resolve_scenario(name)
+        pairs = []
+        for robot in robot_names():
+            for board in board_names():
+                mark = "" if scenario.applies_to(robot, board) else " (n/a)"
+                pairs.append(f"{robot}/{board}{mark}")
+        print(f"  {name:<16} {scenario.description}")
+        print(f"  {'':<16} applies to: {', '.join(p for p in pairs if 'n/a' not in p)}")
+        skipped = [p.split(' ')[0] for p in pairs if "n/a" in p]
+        if skipped:
+            print(f"  {'':<16} does not apply to: {', '.join(skipped)}")
+    return 0
+
+
+def _sim(args: argparse.Namespace) -> int:
+    from ridempc.run import RideRequest, ride
+
+    if args.viewer and args.video:
+        raise ConfigError("--viewer and --video cannot be used together")
+    if args.viewer and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        print(
+            "ridempc: --viewer needs a display and none is available (DISPLAY is not set); "
+            "running headless instead",
+            file=sys.stderr,
+        )
+        args.viewer = False
+    request = RideRequest(
+        robot=args.robot, board=args.board, controller=args.controller, scenario=args.scenario,
+        out=args.out, duration=args.duration, seed=args.seed, video=args.video,
+        plots=not args.no_plots, viewer=args.viewer, ground_truth=args.ground_truth,
+    )
+    summary = ride(request)
+    rtf = summary["real_time_factor"]
+    line = (
+        f"{summary['robot']}/{summary['board']}/{summary['controller']} "
+        f"'{summary['scenario']}' seed {summary['seed']}: {summary['status']}"
+    )
+    if summary["fell"]:
+        line += f" at {summary['fall_time_s']:.2f} s ({summary['fall_reason']})"
+    if summary["error"]:
+        line += f" ({summary['error']})"
+    line += (
+        f"; {summary['sim_time_s']:.2f} s simulated in {summary['wall_time_s']:.2f} s"
+        f" ({rtf}x real time); results in {args.out}"
+    )
+    print(line)
+    return EXIT_FAILED if summary["status"] == "failed" else 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "list":
+            return _list()
+        return _sim(args)
+    except (UnknownNameError, ConfigError) as exc:
+        print(f"ridempc: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RidempcError as exc:
+        print(f"ridempc: failed: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        print("ridempc: interrupted; no summary was written", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

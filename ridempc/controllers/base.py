@@ -1,0 +1,44 @@
+"""The interface every rider controller implements.
+
+A controller runs at its own rate (a divisor of the physics rate), reads only a
+:class:`~ridempc.sim.sensors.SensorPacket` and the scenario's
+:class:`~ridempc.scenarios.Command`, and returns a
+:class:`~ridempc.sim.motors.MotorCommand` for the motor drivers.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+from ridempc.robots.robot import Robot
+from ridempc.scenarios.scenario import Command
+from ridempc.sim.motors import MotorCommand
+from ridempc.sim.sensors import SensorPacket
+
+__all__ = ["Controller"]
+
+
+class Controller(ABC):
+    """A rider controller.
+
+    Attributes:
+        rate_hz: How often :meth:`update` runs [Hz].
+        uses_ground_truth: True if it reads ``SensorPacket.truth`` (debugging only).
+    """
+
+    rate_hz: float = 500.0
+    uses_ground_truth: bool = False
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+
+    def reset(self, sensors: SensorPacket) -> None:  # noqa: B027 - optional hook
+        """Called once with the first sensor packet, before the first :meth:`update`."""
+
+    @abstractmethod
+    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        """One control tick."""
+
+    def diagnostics(self) -> dict[str, float]:
+        """Scalars to log at this tick (solve times, modes, ...)."""
+        return {}

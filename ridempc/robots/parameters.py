@@ -1,0 +1,96 @@
+"""Robot parameter files: what a robot's MJCF description cannot say.
+
+Each robot lives in ``robots/<name>/`` as two files:
+
+- ``<name>.xml``: the MJCF description, read by both MuJoCo and Pinocchio (the one
+  source of kinematics, inertias, joint ranges, gear ratios and motor torque limits).
+- ``robot.toml``: this module's :class:`RobotParameters`: which body is the base,
+  where the IMU sits, which bodies are feet, the foot contact points, the fall
+  threshold, and the low-level PD gains and speed limits of each motor.
+
+A second robot of a class is a new folder with these two files, never new code.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ridempc.errors import ConfigError
+
+__all__ = ["MotorParameters", "RobotParameters", "load_robot_parameters"]
+
+PositiveFloat = Annotated[float, Field(gt=0.0)]
+NonNegativeFloat = Annotated[float, Field(ge=0.0)]
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class MotorParameters(_Frozen):
+    """Low-level joint PD of one motor, as the motor driver runs it.
+
+    The driver applies, at the physics rate,
+    :math:`\\tau = \\tau_{ff} + k_p (q^* - q) + k_d (\\dot q^* - \\dot q)`,
+    clipped to the actuator's torque limit from the MJCF description.
+    """
+
+    kp: NonNegativeFloat = Field(description="Default joint stiffness [N m / rad].")
+    kd: NonNegativeFloat = Field(description="Default joint damping [N m s / rad].")
+    speed_limit: PositiveFloat = Field(description="Joint speed limit [rad / s].")
+
+
+class RobotParameters(_Frozen):
+    """Checked, immutable parameters of one robot (``robots/<name>/robot.toml``)."""
+
+    name: str = Field(pattern=r"^[a-z0-9][a-z0-9_-]*$")
+    kind: str = Field(pattern=r"^(biped|quadruped)$")
+    description: str = Field(description="MJCF file name, relative to the robot folder.")
+    base_body: str = Field(description="Floating-base body (pelvis or trunk).")
+    imu_site: str = Field(description="Site where the IMU is mounted.")
+    foot_bodies: tuple[str, ...] = Field(
+        min_length=1, description="Bodies allowed to touch the ground or a board."
+    )
+    contact_sites: tuple[str, ...] = Field(
+        min_length=1, description="Foot contact points (sites), e.g. toe front/back."
+    )
+    encoder_joints: tuple[str, ...] = Field(
+        default=(), description="Passive joints with encoders, besides the motor joints."
+    )
+    stand_keyframe: str = Field(default="stand", description="MJCF keyframe to start from.")
+    fall_height: PositiveFloat = Field(
+        description="Base origin below this height over its support = fall [m]."
+    )
+    motors: dict[str, MotorParameters] = Field(
+        min_length=1, description="Per motor, keyed by actuator name."
+    )
+
+    @model_validator(mode="after")
+    def _contact_sites_unique(self) -> RobotParameters:
+        if len(set(self.contact_sites)) != len(self.contact_sites):
+            raise ValueError("contact_sites has duplicate entries")
+        return self
+
+
+def load_robot_parameters(path: Path) -> RobotParameters:
+    """Read and check a ``robot.toml`` file.
+
+    Raises:
+        ConfigError: The file is missing, is not TOML, or a field is missing or wrong;
+            the message names the file and the field.
+    """
+    try:
+        with open(path, "rb") as stream:
+            raw = tomllib.load(stream)
+    except FileNotFoundError as exc:
+        raise ConfigError(f"{path}: robot parameter file not found") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
+    try:
+        return RobotParameters.model_validate(raw)
+    except ValidationError as exc:
+        raise ConfigError.from_validation(path, exc) from exc

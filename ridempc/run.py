@@ -1,0 +1,163 @@
+"""One ride, start to finish: resolve names, build the scene, simulate, write the results.
+
+The output folder receives ``log.npz`` (time series), optionally ``video.mp4`` and
+``plots.png``, and last of all ``summary.json``. Every file is written atomically, and a
+stale ``summary.json`` from an earlier run is removed before the new run starts, so an
+interrupted run never leaves a summary that looks complete.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ridempc.boards import NO_BOARD, check_board
+from ridempc.controllers import make_controller
+from ridempc.errors import ConfigError
+from ridempc.io import atomic_write_json, atomic_write_npz
+from ridempc.robots import load_robot
+from ridempc.scenarios import resolve_scenario
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.metrics import run_metrics
+from ridempc.sim.scene import build_scene
+from ridempc.sim.simulation import Simulation
+
+__all__ = ["RideRequest", "ride"]
+
+DEFAULT_SCENARIO = "stand-still"
+
+
+@dataclass(frozen=True)
+class RideRequest:
+    """What ``ridempc sim`` asks for.
+
+    Attributes:
+        robot: Robot name.
+        board: Board name (``none`` for flat ground).
+        controller: Controller name.
+        scenario: Scenario name or path of a scenario file.
+        out: Output folder.
+        duration: Override of the scenario's duration [s], or None.
+        seed: Seed of all random draws.
+        video: Render ``video.mp4``.
+        plots: Write ``plots.png``.
+        viewer: Show the interactive viewer (needs a display).
+        ground_truth: Give the controller ground truth (debugging only; flagged in the summary).
+        physics_hz: Physics rate [Hz].
+    """
+
+    robot: str
+    board: str
+    controller: str
+    scenario: str
+    out: Path
+    duration: float | None = None
+    seed: int = 0
+    video: bool = False
+    plots: bool = True
+    viewer: bool = False
+    ground_truth: bool = False
+    physics_hz: int = DEFAULT_PHYSICS_HZ
+
+
+def _viewer_callback(model: Any, data: Any) -> Any:
+    import time
+
+    import mujoco.viewer
+
+    handle = mujoco.viewer.launch_passive(model, data)
+    started = [time.perf_counter(), data.time]
+
+    def sync(model: Any, data: Any) -> None:
+        ahead = (data.time - started[1]) - (time.perf_counter() - started[0])
+        if ahead > 0:
+            time.sleep(ahead)
+        if handle.is_running():
+            handle.sync()
+
+    return sync
+
+
+def ride(request: RideRequest) -> dict[str, Any]:
+    """Run one ride and write its results; returns the summary.
+
+    Raises:
+        UnknownNameError: A name that does not exist (before anything is written).
+        ConfigError: A malformed scenario or parameter file, or a scenario that does not
+            apply to the robot-board pair.
+    """
+    robot = load_robot(request.robot)
+    board = check_board(request.board)
+    scenario = resolve_scenario(request.scenario)
+    controller = make_controller(request.controller, robot)
+    if not scenario.applies_to(robot.name, board):
+        raise ConfigError(
+            f"scenario '{scenario.name}' does not apply to {robot.name} on board '{board}'"
+        )
+    if board != NO_BOARD:
+        raise ConfigError(f"board '{board}' cannot be simulated yet")
+    if request.duration is not None:
+        if request.duration <= 0:
+            raise ConfigError(f"--duration must be positive, got {request.duration}")
+        scenario = scenario.with_duration(request.duration)
+
+    out = Path(request.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "summary.json").unlink(missing_ok=True)
+
+    scene = build_scene(robot, request.physics_hz)
+    video = None
+    on_frame = None
+    if request.video:
+        from ridempc.sim.video import VideoRecorder
+
+        video = VideoRecorder(scene.model, out / "video.mp4", track_body=scene.base_body)
+        on_frame = video
+    elif request.viewer:
+        on_frame = _viewer_callback(scene.model, scene.data)
+    simulation = Simulation(
+        scene, controller, scenario, seed=request.seed, ground_truth=request.ground_truth,
+        on_frame=on_frame,
+    )
+    try:
+        result = simulation.run()
+    finally:
+        if video is not None:
+            video.close(keep=True)
+
+    atomic_write_npz(out / "log.npz", result.log)
+    files = ["log.npz"]
+    if video is not None and video.frames:
+        files.append("video.mp4")
+    if request.plots and result.log:
+        from ridempc.sim.plots import plot_run
+
+        title = f"{robot.name} / {board} / {request.controller} / {scenario.name} (seed {request.seed})"
+        plot_run(result.log, robot, out / "plots.png", title)
+        files.append("plots.png")
+
+    summary: dict[str, Any] = {
+        "robot": robot.name,
+        "board": board,
+        "controller": request.controller,
+        "scenario": scenario.name,
+        "seed": request.seed,
+        "status": result.status,
+        "error": result.error,
+        "fell": result.fell,
+        "fall_time_s": result.fall_time,
+        "fall_reason": result.fall_reason,
+        "sim_time_s": result.sim_time,
+        "duration_s": scenario.duration,
+        "wall_time_s": round(result.wall_time, 4),
+        "real_time_factor": round(result.sim_time / result.wall_time, 3) if result.wall_time else None,
+        "physics_hz": request.physics_hz,
+        "controller_hz": controller.rate_hz,
+        "ground_truth_feedback": request.ground_truth or controller.uses_ground_truth,
+        **run_metrics(result, scenario, robot),
+        "files": files,
+    }
+    atomic_write_json(out / "summary.json", summary)
+    return summary
+

@@ -1,0 +1,165 @@
+"""Scenarios: a ride's duration, its command timeline, disturbances, noise and parameter changes.
+
+A scenario is a small TOML file, validated on load (unknown keys, wrong types and
+non-physical values are refused with the field named). Example::
+
+    name = "push"
+    description = "Stand, take a 60 N push on the base for 0.2 s at t = 3 s."
+    duration = 10.0            # [s]
+
+    [[commands]]               # piecewise constant, optionally ramped
+    t = 0.0                    # [s]
+    velocity = 0.0             # forward speed [m/s]
+    yaw_rate = 0.0             # [rad/s]
+
+    [[disturbances]]
+    t = 3.0                    # [s]
+    body = "base"              # "base", or a body name of the robot or board
+    force = [60.0, 0.0, 0.0]   # world frame [N]
+    duration = 0.2             # [s]
+
+    [noise]                    # sensor noise overrides, see SensorNoise
+    vio_latency = 0.05
+
+    [[changes]]
+    t = 5.0
+    parameter = "floor_friction"
+    value = 0.6
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ridempc.errors import ConfigError
+from ridempc.sim.sensors import SensorNoise
+
+__all__ = [
+    "Command",
+    "CommandEvent",
+    "Disturbance",
+    "ParameterChange",
+    "Scenario",
+    "load_scenario_file",
+]
+
+Time = Annotated[float, Field(ge=0.0, description="[s]")]
+Vector3 = tuple[float, float, float]
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class Command(_Frozen):
+    """What the rider is asked to do at one instant.
+
+    Attributes:
+        velocity: Forward speed in the heading frame [m/s].
+        yaw_rate: Turning rate [rad/s], positive to the left.
+        lateral_offset: Lateral foot offset for the wave pattern [m].
+        roll: Board roll reference [rad].
+    """
+
+    velocity: float = 0.0
+    yaw_rate: float = 0.0
+    lateral_offset: float = 0.0
+    roll: float = 0.0
+
+
+class CommandEvent(_Frozen):
+    """From time ``t``, set the given command fields (ramped over ``ramp`` seconds)."""
+
+    t: Time
+    ramp: Annotated[float, Field(ge=0.0)] = 0.0
+    velocity: float | None = None
+    yaw_rate: float | None = None
+    lateral_offset: float | None = None
+    roll: float | None = None
+
+    def fields(self) -> dict[str, float]:
+        return {k: v for k, v in self.model_dump().items() if k not in ("t", "ramp") and v is not None}
+
+
+class Disturbance(_Frozen):
+    """A force (and torque) applied to a body for a while: a push or a kick."""
+
+    t: Time
+    body: str = "base"
+    force: Vector3 = (0.0, 0.0, 0.0)  # world frame [N]
+    torque: Vector3 = (0.0, 0.0, 0.0)  # world frame [N m]
+    duration: Annotated[float, Field(gt=0.0, le=5.0)] = 0.1  # [s]
+    per_kg: bool = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
+
+
+class ParameterChange(_Frozen):
+    """A change of a physical parameter during the run."""
+
+    t: Time
+    parameter: Literal["floor_friction", "base_payload"]  # [-] / [kg] added to the base
+    value: float
+
+
+class Scenario(_Frozen):
+    """A checked, immutable scenario."""
+
+    name: str = Field(pattern=r"^[a-z0-9][a-z0-9._-]*$")
+    description: str = ""
+    duration: Annotated[float, Field(gt=0.0, le=3600.0)]  # [s]
+    robots: tuple[str, ...] = ()  # robots it applies to; empty means any
+    boards: tuple[str, ...] = ()  # boards it applies to; empty means any
+    metrics_start: Time = 0.0  # tracking errors are measured from this time on [s]
+    commands: tuple[CommandEvent, ...] = ()
+    disturbances: tuple[Disturbance, ...] = ()
+    changes: tuple[ParameterChange, ...] = ()
+    noise: SensorNoise = SensorNoise()
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Scenario:
+        times = [c.t for c in self.commands]
+        if times != sorted(times):
+            raise ValueError("commands must be in time order")
+        return self
+
+    def applies_to(self, robot: str, board: str) -> bool:
+        return (not self.robots or robot in self.robots) and (not self.boards or board in self.boards)
+
+    def command_at(self, t: float) -> Command:
+        """The command in force at time ``t`` [s] (piecewise constant, linear ramps)."""
+        values = Command().model_dump()
+        for event in self.commands:
+            if event.t > t:
+                break
+            for key, target in event.fields().items():
+                if event.ramp > 0.0 and t < event.t + event.ramp:
+                    alpha = (t - event.t) / event.ramp
+                    values[key] = values[key] + alpha * (target - values[key])
+                else:
+                    values[key] = target
+        return Command(**values)
+
+    def with_duration(self, duration: float) -> Scenario:
+        return self.model_copy(update={"duration": duration})
+
+
+def load_scenario_file(path: Path) -> Scenario:
+    """Read and check a scenario file.
+
+    Raises:
+        ConfigError: Missing file, not TOML, or a bad field (named in the message).
+    """
+    try:
+        with open(path, "rb") as stream:
+            raw = tomllib.load(stream)
+    except FileNotFoundError as exc:
+        raise ConfigError(f"{path}: scenario file not found") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
+    try:
+        return Scenario.model_validate(raw)
+    except ValidationError as exc:
+        raise ConfigError.from_validation(path, exc) from exc

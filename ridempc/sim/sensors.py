@@ -1,0 +1,225 @@
+"""What a rider controller receives: IMU, joint encoders, motor torques and visual-inertial odometry.
+
+A controller never reads the simulator's state. Each control tick it gets one
+:class:`SensorPacket`, built here from MuJoCo's sensors and the true state with the noise,
+quantisation and latency of :class:`SensorNoise`:
+
+- IMU at the robot's IMU site: orientation quaternion (w, x, y, z) with a small random
+  tilt/yaw error, gyro :math:`\\omega_B + n_\\omega` [rad/s] and accelerometer
+  :math:`R_{WB}^\\top(\\ddot p - g) + n_a` [m/s^2] (MuJoCo's ``accelerometer``).
+- Joint encoders: position quantised to the encoder resolution plus noise [rad], velocity
+  plus noise [rad/s], for the motor joints and the instrumented passive joints.
+- Motor torques: the joint-side torque each motor applied [N m].
+- Visual-inertial odometry (VIO): base position [m], yaw [rad], world-frame velocity [m/s]
+  and yaw rate [rad/s], sampled at ``vio_hz`` and delivered ``vio_latency`` seconds later,
+  each with Gaussian noise. ``vio`` is the newest delivered sample (or None before the first),
+  stamped with the time it was captured.
+
+Ground truth (``truth``) is filled only when the simulation runs with ``ground_truth=True``,
+for debugging; a run that feeds it back is marked as such in its summary.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field
+
+__all__ = ["GroundTruth", "ImuReading", "SensorNoise", "SensorPacket", "SensorSuite", "VioReading"]
+
+Array = NDArray[np.float64]
+
+
+class SensorNoise(BaseModel):
+    """Noise, resolution and latency of the rider's sensors (scenario ``[noise]`` table)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    imu_orientation_std: float = Field(0.002, ge=0, description="[rad] per axis")
+    imu_gyro_std: float = Field(0.005, ge=0, description="[rad/s]")
+    imu_accel_std: float = Field(0.05, ge=0, description="[m/s^2]")
+    encoder_resolution: float = Field(
+        2 * np.pi / 2**14, ge=0, description="[rad] quantisation step (14-bit)"
+    )
+    encoder_velocity_std: float = Field(0.01, ge=0, description="[rad/s]")
+    torque_std: float = Field(0.05, ge=0, description="[N m]")
+    vio_hz: float = Field(30.0, gt=0, description="[Hz] VIO sample rate")
+    vio_latency: float = Field(0.03, ge=0, le=1.0, description="[s] capture-to-delivery delay")
+    vio_position_std: float = Field(0.01, ge=0, description="[m]")
+    vio_yaw_std: float = Field(0.005, ge=0, description="[rad]")
+    vio_velocity_std: float = Field(0.02, ge=0, description="[m/s]")
+    vio_yaw_rate_std: float = Field(0.01, ge=0, description="[rad/s]")
+
+
+@dataclass(frozen=True)
+class ImuReading:
+    quaternion: Array  # (w, x, y, z), body to world
+    angular_velocity: Array  # [rad/s], body frame
+    linear_acceleration: Array  # [m/s^2], body frame, specific force
+
+
+@dataclass(frozen=True)
+class VioReading:
+    stamp: float  # [s] capture time
+    position: Array  # [m], world
+    yaw: float  # [rad]
+    velocity: Array  # [m/s], world
+    yaw_rate: float  # [rad/s]
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    qpos: Array  # robot's MuJoCo configuration
+    qvel: Array  # robot's MuJoCo velocity
+
+
+@dataclass(frozen=True)
+class SensorPacket:
+    """Everything a rider controller may read at one control tick.
+
+    Attributes:
+        time: Simulation time [s].
+        imu: The IMU reading.
+        joint_position: Encoder positions [rad], ordered as ``SensorSuite.encoder_joints``.
+        joint_velocity: Encoder velocities [rad/s], same order.
+        motor_torque: Joint-side torque applied by each motor [N m], actuator order.
+        vio: Newest delivered VIO sample, or None before the first arrives.
+        truth: Ground truth, only when the run enables it for debugging.
+    """
+
+    time: float
+    imu: ImuReading
+    joint_position: Array
+    joint_velocity: Array
+    motor_torque: Array
+    vio: VioReading | None
+    truth: GroundTruth | None = None
+
+
+def _yaw_of(quat_wxyz: Array) -> float:
+    w, x, y, z = quat_wxyz
+    return float(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+
+
+class SensorSuite:
+    """Reads MuJoCo sensors and the true base state into noisy, delayed sensor packets.
+
+    Args:
+        model: Compiled scene holding the robot's sensors (added by the scene builder).
+        encoder_joints: Joints with encoders, in packet order.
+        base_body: Name of the robot's base body (VIO is attached to it).
+        imu_site: Name of the IMU site.
+        robot_qpos: Slice of the scene's qpos that is the robot's.
+        robot_qvel: Slice of the scene's qvel that is the robot's.
+        actuators: Scene actuator ids of the robot's motors.
+        noise: Noise, resolution and latency.
+        physics_hz: Physics rate [Hz], to express the VIO latency in steps.
+        rng: Random generator (seeded by the run).
+        ground_truth: Fill ``SensorPacket.truth`` (debugging only).
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        encoder_joints: tuple[str, ...],
+        base_body: str,
+        imu_site: str,
+        robot_qpos: slice,
+        robot_qvel: slice,
+        actuators: NDArray[np.int64],
+        noise: SensorNoise,
+        physics_hz: int,
+        rng: np.random.Generator,
+        ground_truth: bool = False,
+    ) -> None:
+        self._model = model
+        self.noise = noise
+        self.rng = rng
+        self.ground_truth = ground_truth
+        self.encoder_joints = encoder_joints
+        joint_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in encoder_joints]
+        self._enc_qpos = np.array([model.jnt_qposadr[j] for j in joint_ids])
+        self._enc_dof = np.array([model.jnt_dofadr[j] for j in joint_ids])
+        self._base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, base_body)
+        self._robot_qpos = robot_qpos
+        self._robot_qvel = robot_qvel
+        self._actuators = actuators
+        self._imu_quat = self._sensor_slice(model, f"{imu_site}_quat")
+        self._imu_gyro = self._sensor_slice(model, f"{imu_site}_gyro")
+        self._imu_acc = self._sensor_slice(model, f"{imu_site}_accel")
+        self._vio_period = max(1, round(physics_hz / noise.vio_hz))
+        self._vio_delay = round(noise.vio_latency * physics_hz)
+        self._physics_hz = physics_hz
+        self._vio_queue: deque[tuple[int, VioReading]] = deque()
+        self._vio_latest: VioReading | None = None
+
+    @staticmethod
+    def _sensor_slice(model: mujoco.MjModel, name: str) -> slice:
+        sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name)
+        adr, dim = int(model.sensor_adr[sid]), int(model.sensor_dim[sid])
+        return slice(adr, adr + dim)
+
+    def _noise(self, std: float, size: int) -> Array:
+        return self.rng.normal(0.0, std, size) if std > 0 else np.zeros(size)
+
+    def sample_vio(self, tick: int, data: mujoco.MjData) -> None:
+        """At VIO rate: capture the base pose now, to be delivered after the latency."""
+        if tick % self._vio_period:
+            return
+        n = self.noise
+        quat = data.xquat[self._base]
+        vel_world = self._base_velocity_world(data)
+        reading = VioReading(
+            stamp=tick / self._physics_hz,
+            position=data.xpos[self._base] + self._noise(n.vio_position_std, 3),
+            yaw=_yaw_of(quat) + float(self._noise(n.vio_yaw_std, 1)[0]),
+            velocity=vel_world[3:] + self._noise(n.vio_velocity_std, 3),
+            yaw_rate=float(vel_world[2]) + float(self._noise(n.vio_yaw_rate_std, 1)[0]),
+        )
+        self._vio_queue.append((tick + self._vio_delay, reading))
+
+    def _base_velocity_world(self, data: mujoco.MjData) -> Array:
+        """(angular, linear) velocity of the base origin in the world frame."""
+        out = np.empty(6)
+        mujoco.mj_objectVelocity(self._model, data, mujoco.mjtObj.mjOBJ_BODY, self._base, out, 0)
+        return out
+
+    def read(self, tick: int, data: mujoco.MjData) -> SensorPacket:
+        """The packet a controller gets at this tick (after ``mj_forward``/``mj_step``)."""
+        n = self.noise
+        while self._vio_queue and self._vio_queue[0][0] <= tick:
+            self._vio_latest = self._vio_queue.popleft()[1]
+        quat = np.array(data.sensordata[self._imu_quat])
+        tilt = self._noise(n.imu_orientation_std, 3)
+        if np.any(tilt):
+            error = np.empty(4)
+            mujoco.mju_axisAngle2Quat(error, tilt / np.linalg.norm(tilt), np.linalg.norm(tilt))
+            mujoco.mju_mulQuat(quat, quat.copy(), error)
+        imu = ImuReading(
+            quaternion=quat,
+            angular_velocity=data.sensordata[self._imu_gyro] + self._noise(n.imu_gyro_std, 3),
+            linear_acceleration=data.sensordata[self._imu_acc] + self._noise(n.imu_accel_std, 3),
+        )
+        q = data.qpos[self._enc_qpos]
+        if n.encoder_resolution > 0:
+            q = np.round(q / n.encoder_resolution) * n.encoder_resolution
+        count = len(self._enc_qpos)
+        truth = None
+        if self.ground_truth:
+            truth = GroundTruth(
+                qpos=np.array(data.qpos[self._robot_qpos]), qvel=np.array(data.qvel[self._robot_qvel])
+            )
+        return SensorPacket(
+            time=tick / self._physics_hz,
+            imu=imu,
+            joint_position=q,
+            joint_velocity=data.qvel[self._enc_dof] + self._noise(n.encoder_velocity_std, count),
+            motor_torque=data.actuator_force[self._actuators]
+            + self._noise(n.torque_std, len(self._actuators)),
+            vio=self._vio_latest,
+            truth=truth,
+        )

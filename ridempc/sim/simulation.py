@@ -1,0 +1,244 @@
+"""The multi-rate simulation loop.
+
+Every physics step (``1 / physics_hz`` s), in this order:
+
+1. disturbances and parameter changes due now are applied;
+2. the VIO captures a sample if due (delivered later, after its latency);
+3. the rider controller runs if due, on a fresh sensor packet and the scenario's command;
+4. the motor drivers apply their PD law to the latest motor command;
+5. MuJoCo steps.
+
+Controllers run every ``physics_hz / rate_hz`` steps exactly (see :mod:`ridempc.sim.clock`).
+The judge (fall detection, divergence checks, logging) reads the true state at
+``log_hz``; nothing it reads reaches the controller. Runs are deterministic for a seed.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.controllers.base import Controller
+from ridempc.errors import ConfigError, SimulationDiverged
+from ridempc.scenarios.scenario import Disturbance, Scenario
+from ridempc.sim.clock import Rate
+from ridempc.sim.falls import FallDetector
+from ridempc.sim.motors import MotorDriver
+from ridempc.sim.recorder import Recorder
+from ridempc.sim.scene import Scene
+from ridempc.sim.sensors import SensorSuite
+
+__all__ = ["RunResult", "Simulation"]
+
+Array = NDArray[np.float64]
+MAX_SPEED: float = 100.0  # [m/s or rad/s] any generalised velocity above this is an explosion
+
+
+@dataclass
+class RunResult:
+    """What happened in a run (from the judge's true-state view).
+
+    Attributes:
+        status: ``ok``, ``fell`` or ``failed``.
+        sim_time: Simulated time reached [s].
+        wall_time: Wall-clock time of the loop [s].
+        fall_time: When the fall happened [s], or None.
+        fall_reason: Why it counts as a fall, or None.
+        error: Why the run failed, or None.
+        log: Time series at the logging rate.
+        controller_times: Wall time of each controller update [s].
+    """
+
+    status: str
+    sim_time: float
+    wall_time: float
+    fall_time: float | None = None
+    fall_reason: str | None = None
+    error: str | None = None
+    log: dict[str, Array] = field(default_factory=dict)
+    controller_times: Array = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def fell(self) -> bool:
+        return self.fall_time is not None
+
+
+def _yaw(quat_wxyz: Array) -> float:
+    w, x, y, z = quat_wxyz
+    return float(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+
+
+class Simulation:
+    """Runs one scenario with one controller on one scene.
+
+    Args:
+        scene: The compiled scene (reset to its initial state here).
+        controller: The rider controller.
+        scenario: Duration, commands, disturbances, noise and changes.
+        seed: Seed of every random draw in the run (sensor noise).
+        ground_truth: Put ground truth in the sensor packets (debugging only).
+        log_hz: Logging and judging rate [Hz].
+        frame_hz: Rate of ``on_frame`` calls [Hz] (video).
+        on_frame: Called with (model, data) at ``frame_hz``, e.g. to render video.
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        controller: Controller,
+        scenario: Scenario,
+        seed: int = 0,
+        ground_truth: bool = False,
+        log_hz: float = 100.0,
+        frame_hz: float = 30.0,
+        on_frame: Callable[[mujoco.MjModel, mujoco.MjData], None] | None = None,
+    ) -> None:
+        self.scene = scene
+        self.controller = controller
+        self.scenario = scenario
+        self.seed = seed
+        hz = scene.physics_hz
+        self.control_rate = Rate.of(controller.rate_hz, hz, "controller")
+        self.log_rate = Rate.of(log_hz, hz, "log")
+        self.frame_rate = Rate.of(frame_hz, hz, "video frame")
+        self.on_frame = on_frame
+        self.ground_truth = ground_truth
+        robot = scene.robot
+        self.sensors = SensorSuite(
+            scene.model,
+            encoder_joints=robot.encoder_joints,
+            base_body=robot.params.base_body,
+            imu_site=robot.params.imu_site,
+            robot_qpos=scene.robot_qpos,
+            robot_qvel=scene.robot_qvel,
+            actuators=scene.actuator_ids,
+            noise=scenario.noise,
+            physics_hz=hz,
+            rng=np.random.default_rng(seed),
+            ground_truth=ground_truth,
+        )
+        self.driver = MotorDriver(scene.model, robot.motors, scene.actuator_ids)
+        self.falls = FallDetector(scene)
+        self._pushes = [(self._body_of(d), d) for d in scenario.disturbances]
+
+    def _body_of(self, disturbance: Disturbance) -> int:
+        if disturbance.body == "base":
+            return self.scene.base_body
+        body = mujoco.mj_name2id(self.scene.model, mujoco.mjtObj.mjOBJ_BODY, disturbance.body)
+        if body < 0:
+            names = [
+                mujoco.mj_id2name(self.scene.model, mujoco.mjtObj.mjOBJ_BODY, b)
+                for b in range(1, self.scene.model.nbody)
+            ]
+            raise ConfigError(
+                f"scenario '{self.scenario.name}': disturbance body '{disturbance.body}' "
+                f"does not exist (valid: base, {', '.join(names)})"
+            )
+        return body
+
+    def _apply_disturbances(self, t: float, data: mujoco.MjData) -> None:
+        data.xfrc_applied[:] = 0.0
+        mass = self.scene.robot.mass
+        for body, push in self._pushes:
+            if push.t <= t < push.t + push.duration:
+                scale = mass if push.per_kg else 1.0
+                data.xfrc_applied[body, :3] += scale * np.asarray(push.force)
+                data.xfrc_applied[body, 3:] += scale * np.asarray(push.torque)
+
+    def _apply_changes(self, tick: int, model: mujoco.MjModel) -> None:
+        hz = self.scene.physics_hz
+        for change in self.scenario.changes:
+            if round(change.t * hz) != tick:
+                continue
+            if change.parameter == "floor_friction":
+                for geom in self.scene.ground_geoms:
+                    model.geom_friction[geom, 0] = change.value
+            elif change.parameter == "base_payload":
+                model.body_mass[self.scene.base_body] += change.value
+
+    def _log_row(self, recorder: Recorder, t: float, data: mujoco.MjData) -> None:
+        scene = self.scene
+        base = scene.base_body
+        velocity = np.empty(6)
+        mujoco.mj_objectVelocity(scene.model, data, mujoco.mjtObj.mjOBJ_BODY, base, velocity, 0)
+        yaw = _yaw(data.xquat[base])
+        command = self.scenario.command_at(t)
+        recorder.append(
+            time=t,
+            base_position=data.xpos[base],
+            base_quaternion=data.xquat[base],
+            base_velocity=velocity[3:],
+            base_angular_velocity=velocity[:3],
+            forward_velocity=np.cos(yaw) * velocity[3] + np.sin(yaw) * velocity[4],
+            yaw=yaw,
+            yaw_rate=velocity[2],
+            command_velocity=command.velocity,
+            command_yaw_rate=command.yaw_rate,
+            qpos=data.qpos[scene.robot_qpos],
+            qvel=data.qvel[scene.robot_qvel],
+            motor_torque=self.driver.torque(data),
+        )
+
+    def _check_finite(self, t: float, data: mujoco.MjData) -> None:
+        bad_acc = data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
+        if bad_acc:
+            raise SimulationDiverged(t, "MuJoCo reported a bad acceleration (NaN or Inf)")
+        if not np.all(np.isfinite(data.qpos)) or not np.all(np.isfinite(data.qvel)):
+            raise SimulationDiverged(t, "state is not finite")
+        speed = float(np.max(np.abs(data.qvel)))
+        if speed > MAX_SPEED:
+            raise SimulationDiverged(t, f"a velocity reached {speed:.3g} (limit {MAX_SPEED})")
+
+    def run(self) -> RunResult:
+        """Run the scenario to its end, a fall or a failure."""
+        scene = self.scene
+        model, data = scene.model, scene.data
+        scene.reset()
+        hz = scene.physics_hz
+        n_ticks = round(self.scenario.duration * hz)
+        recorder = Recorder()
+        times: list[float] = []
+        result = RunResult(status="ok", sim_time=0.0, wall_time=0.0)
+        start = time.perf_counter()
+        tick = 0
+        try:
+            for tick in range(n_ticks + 1):
+                t = tick / hz
+                if self.log_rate.due(tick):
+                    self._check_finite(t, data)
+                    self._log_row(recorder, t, data)
+                    reason = self.falls.check(model, data)
+                    if reason is not None:
+                        result.status, result.fall_time, result.fall_reason = "fell", t, reason
+                        break
+                if self.on_frame is not None and self.frame_rate.due(tick):
+                    self.on_frame(model, data)
+                if tick == n_ticks:
+                    break
+                self._apply_changes(tick, model)
+                self._apply_disturbances(t, data)
+                self.sensors.sample_vio(tick, data)
+                if self.control_rate.due(tick):
+                    packet = self.sensors.read(tick, data)
+                    if tick == 0:
+                        self.controller.reset(packet)
+                    began = time.perf_counter()
+                    command = self.controller.update(packet, self.scenario.command_at(t))
+                    times.append(time.perf_counter() - began)
+                    if not command.is_finite():
+                        raise SimulationDiverged(t, "the controller returned a non-finite command")
+                    self.driver.command = command
+                self.driver.apply(data)
+                mujoco.mj_step(model, data)
+        except SimulationDiverged as exc:
+            result.status, result.error = "failed", str(exc)
+        result.sim_time = tick / hz
+        result.wall_time = time.perf_counter() - start
+        result.log = recorder.arrays()
+        result.controller_times = np.array(times)
+        return result

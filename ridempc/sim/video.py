@@ -1,0 +1,52 @@
+"""Offscreen video of a run: frames rendered at 30 Hz of simulation time, written as mp4."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+__all__ = ["VideoRecorder"]
+
+
+class VideoRecorder:
+    """Renders frames from a camera tracking the robot's base and writes them to mp4.
+
+    Frames are streamed to a temporary file that is renamed into place only when the
+    video is complete.
+    """
+
+    def __init__(
+        self, model: mujoco.MjModel, path: Path, track_body: int, fps: int = 30,
+        width: int = 640, height: int = 480,
+    ) -> None:
+        import imageio.v2 as imageio
+
+        self.path = Path(path)
+        self._tmp = self.path.with_name(f".{self.path.name}.tmp.mp4")
+        self._renderer = mujoco.Renderer(model, height=height, width=width)
+        self._camera = mujoco.MjvCamera()
+        self._camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+        self._camera.trackbodyid = track_body
+        self._camera.distance = 3.0
+        self._camera.azimuth = 135.0
+        self._camera.elevation = -15.0
+        self._writer = imageio.get_writer(self._tmp, fps=fps, macro_block_size=1)
+        self.frames = 0
+        self.last_frame: np.ndarray | None = None
+
+    def __call__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        self._renderer.update_scene(data, self._camera)
+        frame = self._renderer.render()
+        self._writer.append_data(frame)
+        self.last_frame = frame
+        self.frames += 1
+
+    def close(self, keep: bool = True) -> None:
+        self._writer.close()
+        self._renderer.close()
+        if keep and self.frames:
+            self._tmp.replace(self.path)
+        else:
+            self._tmp.unlink(missing_ok=True)
