@@ -39,7 +39,8 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--no-plots", action="store_true", help="do not write plots.png")
     sim.add_argument("--viewer", action="store_true", help="open MuJoCo's interactive viewer")
     sim.add_argument(
-        "--ground-truth", action="store_true",
+        "--ground-truth",
+        action="store_true",
         help="debugging only: put ground truth in the sensor packets (flagged in the summary)",
     )
 
@@ -66,7 +67,7 @@ def _list() -> int:
                 pairs.append(f"{robot}/{board}{mark}")
         print(f"  {name:<16} {scenario.description}")
         print(f"  {'':<16} applies to: {', '.join(p for p in pairs if 'n/a' not in p)}")
-        skipped = [p.split(' ')[0] for p in pairs if "n/a" in p]
+        skipped = [p.split(" ")[0] for p in pairs if "n/a" in p]
         if skipped:
             print(f"  {'':<16} does not apply to: {', '.join(skipped)}")
     return 0
@@ -85,9 +86,17 @@ def _sim(args: argparse.Namespace) -> int:
         )
         args.viewer = False
     request = RideRequest(
-        robot=args.robot, board=args.board, controller=args.controller, scenario=args.scenario,
-        out=args.out, duration=args.duration, seed=args.seed, video=args.video,
-        plots=not args.no_plots, viewer=args.viewer, ground_truth=args.ground_truth,
+        robot=args.robot,
+        board=args.board,
+        controller=args.controller,
+        scenario=args.scenario,
+        out=args.out,
+        duration=args.duration,
+        seed=args.seed,
+        video=args.video,
+        plots=not args.no_plots,
+        viewer=args.viewer,
+        ground_truth=args.ground_truth,
     )
     summary = ride(request)
     rtf = summary["real_time_factor"]

@@ -32,8 +32,15 @@ def atomic_write(path: Path, write: Callable[[IO[bytes]], None]) -> None:
 
 def atomic_write_json(path: Path, payload: Mapping[str, Any]) -> None:
     text = json.dumps(payload, indent=2, sort_keys=False, allow_nan=False) + "\n"
-    atomic_write(path, lambda s: s.write(text.encode()))
+
+    def write(stream: IO[bytes]) -> None:
+        stream.write(text.encode())
+
+    atomic_write(path, write)
 
 
 def atomic_write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
-    atomic_write(path, lambda s: np.savez_compressed(s, **arrays))
+    def write(stream: IO[bytes]) -> None:
+        np.savez_compressed(stream, **arrays)  # type: ignore[arg-type]
+
+    atomic_write(path, write)

@@ -117,7 +117,11 @@ def ride(request: RideRequest) -> dict[str, Any]:
     elif request.viewer:
         on_frame = _viewer_callback(scene.model, scene.data)
     simulation = Simulation(
-        scene, controller, scenario, seed=request.seed, ground_truth=request.ground_truth,
+        scene,
+        controller,
+        scenario,
+        seed=request.seed,
+        ground_truth=request.ground_truth,
         on_frame=on_frame,
     )
     try:
@@ -133,7 +137,9 @@ def ride(request: RideRequest) -> dict[str, Any]:
     if request.plots and result.log:
         from ridempc.sim.plots import plot_run
 
-        title = f"{robot.name} / {board} / {request.controller} / {scenario.name} (seed {request.seed})"
+        title = (
+            f"{robot.name} / {board} / {request.controller} / {scenario.name} (seed {request.seed})"
+        )
         plot_run(result.log, robot, out / "plots.png", title)
         files.append("plots.png")
 
@@ -151,7 +157,9 @@ def ride(request: RideRequest) -> dict[str, Any]:
         "sim_time_s": result.sim_time,
         "duration_s": scenario.duration,
         "wall_time_s": round(result.wall_time, 4),
-        "real_time_factor": round(result.sim_time / result.wall_time, 3) if result.wall_time else None,
+        "real_time_factor": round(result.sim_time / result.wall_time, 3)
+        if result.wall_time
+        else None,
         "physics_hz": request.physics_hz,
         "controller_hz": controller.rate_hz,
         "ground_truth_feedback": request.ground_truth or controller.uses_ground_truth,
@@ -160,4 +168,3 @@ def ride(request: RideRequest) -> dict[str, Any]:
     }
     atomic_write_json(out / "summary.json", summary)
     return summary
-

@@ -95,9 +95,7 @@ class Robot:
             gear = float(model.actuator_gear[i, 0])
             ctrl_max = float(np.max(np.abs(model.actuator_ctrlrange[i])))
             p = self.params.motors[name]
-            motors.append(
-                Motor(name, joint, gear, gear * ctrl_max, p.speed_limit, p.kp, p.kd)
-            )
+            motors.append(Motor(name, joint, gear, gear * ctrl_max, p.speed_limit, p.kp, p.kd))
             names.add(name)
         extra = set(self.params.motors) - names
         if extra:

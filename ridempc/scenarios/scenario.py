@@ -82,7 +82,9 @@ class CommandEvent(_Frozen):
     roll: float | None = None
 
     def fields(self) -> dict[str, float]:
-        return {k: v for k, v in self.model_dump().items() if k not in ("t", "ramp") and v is not None}
+        return {
+            k: v for k, v in self.model_dump().items() if k not in ("t", "ramp") and v is not None
+        }
 
 
 class Disturbance(_Frozen):
@@ -126,7 +128,9 @@ class Scenario(_Frozen):
         return self
 
     def applies_to(self, robot: str, board: str) -> bool:
-        return (not self.robots or robot in self.robots) and (not self.boards or board in self.boards)
+        return (not self.robots or robot in self.robots) and (
+            not self.boards or board in self.boards
+        )
 
     def command_at(self, t: float) -> Command:
         """The command in force at time ``t`` [s] (piecewise constant, linear ramps)."""

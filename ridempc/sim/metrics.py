@@ -40,7 +40,9 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot) -> dict[str
     metrics: dict[str, Any] = {
         "velocity_rmse": _rmse(log["forward_velocity"][window] - log["command_velocity"][window]),
         "yaw_rate_rmse": _rmse(log["yaw_rate"][window] - log["command_yaw_rate"][window]),
-        "peak_torque": {m.name: round(float(p), 3) for m, p in zip(robot.motors, peak, strict=True)},
+        "peak_torque": {
+            m.name: round(float(p), 3) for m, p in zip(robot.motors, peak, strict=True)
+        },
         "peak_torque_ratio": float(np.max(peak / limits)),
         "base_height_initial": float(log["base_position"][0, 2]),
         "base_height_drift": float(log["base_position"][-1, 2] - log["base_position"][0, 2]),

@@ -21,7 +21,9 @@ class Recorder:
 
     def append(self, **values: float | NDArray[np.float64]) -> None:
         for name, value in values.items():
-            self._columns[name].append(np.array(value, dtype=float))  # a copy: MuJoCo arrays are views
+            self._columns[name].append(
+                np.array(value, dtype=float)
+            )  # a copy: MuJoCo arrays are views
 
     def arrays(self) -> dict[str, NDArray[np.float64]]:
         return {name: np.stack(rows) for name, rows in self._columns.items() if rows}

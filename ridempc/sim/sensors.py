@@ -1,4 +1,4 @@
-"""What a rider controller receives: IMU, joint encoders, motor torques and visual-inertial odometry.
+"""What a rider controller receives: IMU, joint encoders, motor torques and visual odometry.
 
 A controller never reads the simulator's state. Each control tick it gets one
 :class:`SensorPacket`, built here from MuJoCo's sensors and the true state with the noise,
@@ -211,7 +211,8 @@ class SensorSuite:
         truth = None
         if self.ground_truth:
             truth = GroundTruth(
-                qpos=np.array(data.qpos[self._robot_qpos]), qvel=np.array(data.qvel[self._robot_qvel])
+                qpos=np.array(data.qpos[self._robot_qpos]),
+                qvel=np.array(data.qvel[self._robot_qvel]),
             )
         return SensorPacket(
             time=tick / self._physics_hz,

@@ -18,8 +18,13 @@ class VideoRecorder:
     """
 
     def __init__(
-        self, model: mujoco.MjModel, path: Path, track_body: int, fps: int = 30,
-        width: int = 640, height: int = 480,
+        self,
+        model: mujoco.MjModel,
+        path: Path,
+        track_body: int,
+        fps: int = 30,
+        width: int = 640,
+        height: int = 480,
     ) -> None:
         import imageio.v2 as imageio
 

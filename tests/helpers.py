@@ -1,0 +1,50 @@
+"""Small controllers and shortcuts the tests share."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ridempc.controllers.base import Controller
+from ridempc.controllers.stand import StandController
+from ridempc.scenarios.scenario import Command, Scenario
+from ridempc.sim.motors import MotorCommand
+from ridempc.sim.sensors import SensorPacket
+
+
+class LimpController(Controller):
+    """No torque at all: the robot must fall."""
+
+    rate_hz = 500.0
+
+    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        n = len(self.robot.motors)
+        zero = np.zeros(n)
+        return MotorCommand(zero, zero, zero, zero, zero)
+
+
+class NanController(StandController):
+    """Holds the stand, then returns NaN torques from t = 0.5 s."""
+
+    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        hold = super().update(sensors, command)
+        if sensors.time < 0.5:
+            return hold
+        return MotorCommand(hold.torque * np.nan, hold.position, hold.velocity, hold.kp, hold.kd)
+
+
+class RecordingController(StandController):
+    """Stand, and keep every sensor packet it was given."""
+
+    rate_hz = 500.0
+
+    def __init__(self, robot) -> None:
+        super().__init__(robot)
+        self.packets: list[SensorPacket] = []
+
+    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        self.packets.append(sensors)
+        return super().update(sensors, command)
+
+
+def scenario(duration: float, **fields) -> Scenario:
+    return Scenario(name="test", duration=duration, **fields)

@@ -1,0 +1,73 @@
+"""Scenario files are validated on load; the timeline gives the command in force."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from ridempc.errors import ConfigError, UnknownNameError
+from ridempc.scenarios import load_scenario_file, resolve_scenario, scenario_names
+
+
+@pytest.mark.parametrize("name", scenario_names())
+def test_every_library_scenario_loads(name: str) -> None:
+    scenario = resolve_scenario(name)
+    assert scenario.name == name
+    assert scenario.duration > 0
+
+
+def test_unknown_scenario_names_the_valid_ones() -> None:
+    with pytest.raises(UnknownNameError, match="stand-still"):
+        resolve_scenario("no-such-scenario")
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ('name = "x"\n', "duration"),
+        ('name = "x"\nduration = -1.0\n', "duration"),
+        ('name = "x"\nduration = 1.0\nspeed = 3\n', "speed"),
+        (
+            'name = "x"\nduration = 1.0\n[[commands]]\nt = 0.0\nvelocity = "fast"\n',
+            "commands.0.velocity",
+        ),
+        (
+            'name = "x"\nduration = 1.0\n[[disturbances]]\nt = 1.0\nforce = [1, 2]\n',
+            "disturbances.0.force",
+        ),
+        ('name = "x"\nduration = 1.0\n[noise]\nvio_latency = -0.1\n', "noise.vio_latency"),
+        (
+            'name = "x"\nduration = 1.0\n[[changes]]\nt = 1.0\nparameter = "gravity"\nvalue = 1\n',
+            "changes.0.parameter",
+        ),
+    ],
+)
+def test_malformed_scenarios_name_the_field(tmp_path: Path, text: str, field: str) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=f"field '{field}"):
+        load_scenario_file(path)
+
+
+def test_not_toml_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text("name = = 3")
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        load_scenario_file(path)
+
+
+def test_command_timeline_steps_and_ramps(tmp_path: Path) -> None:
+    path = tmp_path / "steps.toml"
+    path.write_text(
+        'name = "steps"\nduration = 10.0\n'
+        "[[commands]]\nt = 0.0\nvelocity = 0.0\n"
+        "[[commands]]\nt = 2.0\nvelocity = 1.0\nramp = 1.0\n"
+        "[[commands]]\nt = 5.0\nyaw_rate = 0.5\n"
+    )
+    scenario = load_scenario_file(path)
+    assert scenario.command_at(1.0).velocity == 0.0
+    assert scenario.command_at(2.5).velocity == pytest.approx(0.5)
+    assert scenario.command_at(4.0).velocity == 1.0
+    assert scenario.command_at(6.0).velocity == 1.0  # kept when a later event sets other fields
+    assert scenario.command_at(6.0).yaw_rate == 0.5
