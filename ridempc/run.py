@@ -112,7 +112,13 @@ def ride(request: RideRequest) -> dict[str, Any]:
     if request.video:
         from ridempc.sim.video import VideoRecorder
 
-        video = VideoRecorder(scene.model, out / "video.mp4", track_body=scene.base_body)
+        height = float(scene.initial_qpos[2])  # frame the robot by its standing height
+        video = VideoRecorder(
+            scene.model,
+            out / "video.mp4",
+            track_body=scene.base_body,
+            distance=max(1.2, 3.0 * height),
+        )
         on_frame = video
     elif request.viewer:
         on_frame = _viewer_callback(scene.model, scene.data)

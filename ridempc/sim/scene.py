@@ -70,6 +70,15 @@ def _add_world(spec: mujoco.MjSpec, physics_hz: int) -> None:
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 720
     spec.add_texture(
+        name="sky",
+        type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+        rgb1=[0.55, 0.7, 0.9],
+        rgb2=[0.1, 0.15, 0.25],
+        width=256,
+        height=256,
+    )
+    spec.add_texture(
         name="grid",
         type=mujoco.mjtTexture.mjTEXTURE_2D,
         builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,

@@ -203,6 +203,7 @@ class Simulation:
         n_ticks = round(self.scenario.duration * hz)
         recorder = Recorder()
         times: list[float] = []
+        friction, masses = model.geom_friction.copy(), model.body_mass.copy()
         result = RunResult(status="ok", sim_time=0.0, wall_time=0.0)
         start = time.perf_counter()
         tick = 0
@@ -237,6 +238,9 @@ class Simulation:
                 mujoco.mj_step(model, data)
         except SimulationDiverged as exc:
             result.status, result.error = "failed", str(exc)
+        finally:  # parameter changes last one run only
+            model.geom_friction[:] = friction
+            model.body_mass[:] = masses
         result.sim_time = tick / hz
         result.wall_time = time.perf_counter() - start
         result.log = recorder.arrays()

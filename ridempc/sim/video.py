@@ -23,6 +23,7 @@ class VideoRecorder:
         path: Path,
         track_body: int,
         fps: int = 30,
+        distance: float = 3.0,
         width: int = 640,
         height: int = 480,
     ) -> None:
@@ -34,7 +35,7 @@ class VideoRecorder:
         self._camera = mujoco.MjvCamera()
         self._camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
         self._camera.trackbodyid = track_body
-        self._camera.distance = 3.0
+        self._camera.distance = distance
         self._camera.azimuth = 135.0
         self._camera.elevation = -15.0
         self._writer = imageio.get_writer(self._tmp, fps=fps, macro_block_size=1)
