@@ -12,8 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ridempc.boards import NO_BOARD, check_board
-from ridempc.controllers import make_controller
+from ridempc.boards import NO_BOARD, load_board
+from ridempc.controllers import NO_ROBOT, make_controller
 from ridempc.errors import ConfigError
 from ridempc.io import atomic_write_json, atomic_write_npz
 from ridempc.robots import load_robot
@@ -87,16 +87,20 @@ def ride(request: RideRequest) -> dict[str, Any]:
         ConfigError: A malformed scenario or parameter file, or a scenario that does not
             apply to the robot-board pair.
     """
-    robot = load_robot(request.robot)
-    board = check_board(request.board)
+    robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
+    board = load_board(request.board)
     scenario = resolve_scenario(request.scenario)
     controller = make_controller(request.controller, robot)
-    if not scenario.applies_to(robot.name, board):
+    board_name = board.name if board is not None else NO_BOARD
+    if not scenario.applies_to(request.robot, board_name):
         raise ConfigError(
-            f"scenario '{scenario.name}' does not apply to {robot.name} on board '{board}'"
+            f"scenario '{scenario.name}' does not apply to {request.robot} on board '{board_name}'"
         )
-    if board != NO_BOARD:
-        raise ConfigError(f"board '{board}' cannot be simulated yet")
+    dead_weight = None
+    if robot is None:
+        if board is None:
+            raise ConfigError(f"robot '{NO_ROBOT}' (a dead weight) needs a board to ride")
+        dead_weight = load_robot(board.params.dead_weight_robot).mass
     if request.duration is not None:
         if request.duration <= 0:
             raise ConfigError(f"--duration must be positive, got {request.duration}")
@@ -106,13 +110,13 @@ def ride(request: RideRequest) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     (out / "summary.json").unlink(missing_ok=True)
 
-    scene = build_scene(robot, request.physics_hz)
+    scene = build_scene(robot, request.physics_hz, board=board, dead_weight=dead_weight)
     video = None
     on_frame = None
     if request.video:
         from ridempc.sim.video import VideoRecorder
 
-        height = float(scene.initial_qpos[2])  # frame the robot by its standing height
+        height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
         video = VideoRecorder(
             scene.model,
             out / "video.mp4",
@@ -144,14 +148,15 @@ def ride(request: RideRequest) -> dict[str, Any]:
         from ridempc.sim.plots import plot_run
 
         title = (
-            f"{robot.name} / {board} / {request.controller} / {scenario.name} (seed {request.seed})"
+            f"{request.robot} / {board_name} / {request.controller} / {scenario.name} "
+            f"(seed {request.seed})"
         )
         plot_run(result.log, robot, out / "plots.png", title)
         files.append("plots.png")
 
     summary: dict[str, Any] = {
-        "robot": robot.name,
-        "board": board,
+        "robot": request.robot,
+        "board": board_name,
         "controller": request.controller,
         "scenario": scenario.name,
         "seed": request.seed,
@@ -167,8 +172,10 @@ def ride(request: RideRequest) -> dict[str, Any]:
         if result.wall_time
         else None,
         "physics_hz": request.physics_hz,
-        "controller_hz": controller.rate_hz,
-        "ground_truth_feedback": request.ground_truth or controller.uses_ground_truth,
+        "controller_hz": controller.rate_hz if controller is not None else None,
+        "ground_truth_feedback": request.ground_truth
+        or (controller is not None and controller.uses_ground_truth),
+        "rider_mass_kg": round(scene.rider_mass, 4),
         **run_metrics(result, scenario, robot),
         "files": files,
     }

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from ridempc.boards.board import Board, load_board_file
 from ridempc.errors import UnknownNameError
 from ridempc.paths import boards_dir
 
-__all__ = ["NO_BOARD", "board_names", "check_board"]
+__all__ = ["NO_BOARD", "board_names", "check_board", "load_board"]
 
 NO_BOARD = "none"
 
@@ -19,3 +20,11 @@ def check_board(name: str) -> str:
     if name not in board_names():
         raise UnknownNameError("board", name, board_names())
     return name
+
+
+def load_board(name: str) -> Board | None:
+    """The board of that name, or None for ``none`` (flat ground)."""
+    check_board(name)
+    if name == NO_BOARD:
+        return None
+    return load_board_file(boards_dir() / name / "board.toml")

@@ -6,10 +6,13 @@ from collections.abc import Callable
 
 from ridempc.controllers.base import Controller
 from ridempc.controllers.stand import StandController
-from ridempc.errors import UnknownNameError
+from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.robots.robot import Robot
 
-__all__ = ["CONTROLLERS", "controller_names", "make_controller"]
+__all__ = ["CONTROLLERS", "DEAD_WEIGHT", "NO_ROBOT", "controller_names", "make_controller"]
+
+NO_ROBOT = "none"  # the robot name of a board ridden by a dead weight
+DEAD_WEIGHT = "dead-weight"  # the controller of a dead weight: none at all
 
 CONTROLLERS: dict[str, Callable[[Robot], Controller]] = {
     "stand": StandController,
@@ -17,10 +20,22 @@ CONTROLLERS: dict[str, Callable[[Robot], Controller]] = {
 
 
 def controller_names() -> tuple[str, ...]:
-    return tuple(sorted(CONTROLLERS))
+    return (*sorted(CONTROLLERS), DEAD_WEIGHT)
 
 
-def make_controller(name: str, robot: Robot) -> Controller:
-    if name not in CONTROLLERS:
-        raise UnknownNameError("controller", name, CONTROLLERS)
+def make_controller(name: str, robot: Robot | None) -> Controller | None:
+    """The named controller for ``robot``; None for a dead weight (``--robot none``).
+
+    Raises:
+        UnknownNameError: No such controller.
+        ConfigError: A dead weight with a controller, or a robot with ``dead-weight``.
+    """
+    if name not in controller_names():
+        raise UnknownNameError("controller", name, controller_names())
+    if robot is None or name == DEAD_WEIGHT:
+        if robot is not None or name != DEAD_WEIGHT:
+            raise ConfigError(
+                f"controller '{DEAD_WEIGHT}' goes with robot '{NO_ROBOT}' and only with it"
+            )
+        return None
     return CONTROLLERS[name](robot)

@@ -1,4 +1,9 @@
-"""Fall detection: the base too low, or a body other than the feet touching the ground."""
+"""Fall detection, from the judge's true-state view (never shown to controllers).
+
+The rider fell when its base is below ``fall_height`` [m] over its starting support, or when
+one of its bodies that is not a foot touches the ground (for a dead weight: any of it).
+The board fell when one of its bodies other than the wheels touches the ground.
+"""
 
 from __future__ import annotations
 
@@ -10,32 +15,34 @@ __all__ = ["FallDetector"]
 
 
 class FallDetector:
-    """Checks the true state for a fall (the judge's view, never shown to controllers).
-
-    A fall is either the base origin below ``fall_height`` [m] over the ground, or a
-    contact between the ground and a robot body that is not a foot.
-    """
-
     def __init__(self, scene: Scene) -> None:
+        model = scene.model
         self._base = scene.base_body
-        self._fall_height = scene.robot.params.fall_height
-        self._forbidden = scene.robot_bodies - scene.foot_bodies
+        robot = scene.robot
+        self._fall_height = (
+            scene.support_height + robot.params.fall_height if robot is not None else None
+        )
+        self._forbidden = {b: "rider" for b in scene.rider_bodies - scene.foot_bodies} | {
+            b: "board" for b in scene.board_bodies - scene.board_ground_bodies
+        }
         self._ground = scene.ground_geoms
         self._names = {
-            b: mujoco.mj_id2name(scene.model, mujoco.mjtObj.mjOBJ_BODY, b) for b in self._forbidden
+            b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in self._forbidden
         }
 
     def check(self, model: mujoco.MjModel, data: mujoco.MjData) -> str | None:
         """The reason of a fall now, or None."""
-        height = data.xpos[self._base, 2]
-        if height < self._fall_height:
-            return f"base height {height:.3f} m below {self._fall_height:.3f} m"
+        if self._fall_height is not None:
+            height = data.xpos[self._base, 2]
+            if height < self._fall_height:
+                return f"base height {height:.3f} m below {self._fall_height:.3f} m"
         for i in range(data.ncon):
-            contact = data.contact[i]
-            g1, g2 = contact.geom[0], contact.geom[1]
+            g1, g2 = data.contact[i].geom
             for ground, other in ((g1, g2), (g2, g1)):
                 if ground in self._ground:
                     body = int(model.geom_bodyid[other])
                     if body in self._forbidden:
-                        return f"'{self._names[body]}' touched the ground"
+                        return (
+                            f"{self._forbidden[body]} body '{self._names[body]}' touched the ground"
+                        )
         return None

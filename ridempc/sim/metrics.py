@@ -5,6 +5,7 @@
   heading frame and :math:`v^*` the commanded speed;
 - ``yaw_rate_rmse`` [rad/s]: :math:`\\sqrt{\\overline{(\\dot\\psi - \\dot\\psi^*)^2}}`;
 - ``peak_torque`` [N m] per motor, and the largest ratio of peak to limit;
+- ``board_max_tilt`` [rad] and ``board_max_speed`` [m/s] of the board's platforms;
 - ``base_height_drift`` [m]: final minus initial base height;
 - ``controller_update_ms``: median and p99 of the controller's update time.
 
@@ -25,31 +26,41 @@ from ridempc.sim.simulation import RunResult
 __all__ = ["run_metrics"]
 
 
+def _tilt(quaternions: np.ndarray) -> np.ndarray:
+    """Angle between a body's z axis and the world's [rad], for (w, x, y, z) quaternions."""
+    x, y = quaternions[..., 1], quaternions[..., 2]
+    return np.arccos(np.clip(1.0 - 2.0 * (x**2 + y**2), -1.0, 1.0))
+
+
 def _rmse(error: np.ndarray) -> float | None:
     return float(np.sqrt(np.mean(error**2))) if error.size else None
 
 
-def run_metrics(result: RunResult, scenario: Scenario, robot: Robot) -> dict[str, Any]:
+def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> dict[str, Any]:
     log = result.log
     if not log:
         return {}
     window = log["time"] >= scenario.metrics_start
-    torque = np.abs(log["motor_torque"])
-    peak = torque.max(axis=0)
-    limits = np.array([m.torque_limit for m in robot.motors])
+    base = log["base_position"]
     metrics: dict[str, Any] = {
         "velocity_rmse": _rmse(log["forward_velocity"][window] - log["command_velocity"][window]),
         "yaw_rate_rmse": _rmse(log["yaw_rate"][window] - log["command_yaw_rate"][window]),
-        "peak_torque": {
-            m.name: round(float(p), 3) for m, p in zip(robot.motors, peak, strict=True)
-        },
-        "peak_torque_ratio": float(np.max(peak / limits)),
-        "base_height_initial": float(log["base_position"][0, 2]),
-        "base_height_drift": float(log["base_position"][-1, 2] - log["base_position"][0, 2]),
-        "distance_travelled": float(
-            np.linalg.norm(log["base_position"][-1, :2] - log["base_position"][0, :2])
-        ),
+        "base_height_initial": float(base[0, 2]),
+        "base_height_drift": float(base[-1, 2] - base[0, 2]),
+        "distance_travelled": float(np.linalg.norm(base[-1, :2] - base[0, :2])),
     }
+    if robot is not None and "motor_torque" in log:
+        peak = np.abs(log["motor_torque"]).max(axis=0)
+        limits = np.array([m.torque_limit for m in robot.motors])
+        metrics["peak_torque"] = {
+            m.name: round(float(p), 3) for m, p in zip(robot.motors, peak, strict=True)
+        }
+        metrics["peak_torque_ratio"] = float(np.max(peak / limits))
+    if "board_quaternion" in log:
+        metrics["board_max_tilt"] = float(np.max(_tilt(log["board_quaternion"])))
+        metrics["board_max_speed"] = float(
+            np.max(np.linalg.norm(log["board_velocity"][..., :2], axis=-1))
+        )
     if result.controller_times.size:
         ms = 1e3 * result.controller_times
         metrics["controller_update_ms"] = {

@@ -11,18 +11,17 @@ from ridempc.robots.robot import Robot
 __all__ = ["plot_run"]
 
 
-def plot_run(log: dict[str, np.ndarray], robot: Robot, path: Path, title: str) -> None:
+def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     t = log["time"]
-    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    board = "board_quaternion" in log
+    fig, axes = plt.subplots(5 if board else 4, 1, figsize=(9, 12 if board else 10), sharex=True)
     axes[0].plot(t, log["base_position"][:, 2])
-    axes[0].axhline(robot.params.fall_height, color="r", ls="--", lw=0.8, label="fall height")
-    axes[0].set_ylabel("base height [m]")
-    axes[0].legend(loc="lower right")
+    axes[0].set_ylabel("rider base height [m]")
     axes[1].plot(t, log["forward_velocity"], label="measured (true)")
     axes[1].plot(t, log["command_velocity"], "k--", label="command")
     axes[1].set_ylabel("forward speed [m/s]")
@@ -31,11 +30,22 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot, path: Path, title: str) -
     axes[2].plot(t, log["command_yaw_rate"], "k--", label="command")
     axes[2].set_ylabel("yaw rate [rad/s]")
     axes[2].legend(loc="upper right")
-    for i, motor in enumerate(robot.motors):
-        axes[3].plot(t, log["motor_torque"][:, i], lw=0.8, label=motor.name)
-    axes[3].set_ylabel("motor torque [N m]")
-    axes[3].set_xlabel("time [s]")
-    axes[3].legend(loc="upper right", fontsize=6, ncol=2)
+    if robot is not None:
+        for i, motor in enumerate(robot.motors):
+            axes[3].plot(t, log["motor_torque"][:, i], lw=0.8, label=motor.name)
+        axes[3].set_ylabel("motor torque [N m]")
+        axes[3].legend(loc="upper right", fontsize=6, ncol=2)
+    if board:
+        quat = log["board_quaternion"]
+        w, x, y, z = (quat[..., i] for i in range(4))
+        pitch = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
+        roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x**2 + y**2))
+        for i in range(quat.shape[1]):
+            axes[-1].plot(t, np.degrees(pitch[:, i]), label=f"platform {i} pitch")
+            axes[-1].plot(t, np.degrees(roll[:, i]), ls=":", label=f"platform {i} roll")
+        axes[-1].set_ylabel("board tilt [deg]")
+        axes[-1].legend(loc="upper right", fontsize=7, ncol=2)
+    axes[-1].set_xlabel("time [s]")
     fig.suptitle(title)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -14,9 +14,11 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.board import Board
+from ridempc.errors import ConfigError
 from ridempc.robots.robot import Robot
 
-__all__ = ["FOOT_CLEARANCE", "Scene", "build_scene"]
+__all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
 
 FOOT_CLEARANCE: float = 0.001  # [m] gap between the lowest foot point and the support at start
 FLOOR_FRICTION: tuple[float, float, float] = (1.0, 0.005, 0.0001)  # slide, spin, roll
@@ -26,6 +28,11 @@ GROUND_SOLREF: tuple[float, float] = (0.005, 1.0)  # time constant [s], damping 
 GROUND_SOLIMP: tuple[float, ...] = (0.95, 0.99, 0.001, 0.5, 2.0)  # impedance, width [m], shape
 
 
+BOARD_PREFIX = "board/"
+DEAD_WEIGHT_DENSITY: float = 7800.0  # [kg / m^3] steel
+DEAD_WEIGHT_HALF_FOOTPRINT: tuple[float, float] = (0.08, 0.06)  # [m] per platform
+
+
 @dataclass
 class Scene:
     """A compiled scene and the indices the simulation needs.
@@ -33,35 +40,50 @@ class Scene:
     Attributes:
         model: Compiled MuJoCo model.
         data: Its data, in the initial state.
-        robot: The rider.
+        robot: The rider, or None when a dead weight rides.
+        board: The board, or None for flat ground.
         physics_hz: Physics rate [Hz].
-        robot_qpos: The robot's slice of qpos.
-        robot_qvel: The robot's slice of qvel.
+        robot_qpos: The robot's slice of qpos (empty without a robot).
+        robot_qvel: The robot's slice of qvel (empty without a robot).
         actuator_ids: Scene actuator ids of the robot's motors, motor order.
-        base_body: Scene body id of the robot's base.
-        robot_bodies: Body ids of the robot.
-        foot_bodies: Body ids allowed to touch the support.
+        base_body: Body id of the rider's base (robot base, or the first dead weight).
+        rider_mass: Mass of the rider [kg].
+        rider_bodies: Body ids of the rider (robot or dead weights).
+        foot_bodies: Rider bodies allowed to touch the ground (none for a dead weight).
+        board_bodies: Body ids of the board.
+        board_roots: Board bodies carrying a free joint (one per independent platform).
+        board_ground_bodies: Board bodies allowed to touch the ground (wheels).
         ground_geoms: Geom ids of the ground.
+        support_height: Height of the rider's support at the start [m] (platform top or 0).
         initial_qpos: The settled initial configuration.
     """
 
     model: mujoco.MjModel
     data: mujoco.MjData
-    robot: Robot
+    robot: Robot | None
+    board: Board | None
     physics_hz: int
     robot_qpos: slice
     robot_qvel: slice
     actuator_ids: NDArray[np.int64]
     base_body: int
-    robot_bodies: frozenset[int]
+    rider_mass: float
+    rider_bodies: frozenset[int]
     foot_bodies: frozenset[int]
+    board_bodies: frozenset[int]
+    board_roots: tuple[int, ...]
+    board_ground_bodies: frozenset[int]
     ground_geoms: frozenset[int]
+    support_height: float
     initial_qpos: NDArray[np.float64]
 
     def reset(self) -> None:
         mujoco.mj_resetData(self.model, self.data)
         self.data.qpos[:] = self.initial_qpos
         mujoco.mj_forward(self.model, self.data)
+
+    def body_id(self, name: str) -> int:
+        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
 
 
 def _add_world(spec: mujoco.MjSpec, physics_hz: int) -> None:
@@ -151,48 +173,196 @@ def _lowest_point(model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[
     return min(bottoms)
 
 
-def build_scene(robot: Robot, physics_hz: int) -> Scene:
-    """Compile the robot standing on flat ground.
+def _free_root(model: mujoco.MjModel, body: int) -> int:
+    """The ancestor of ``body`` that carries a free joint."""
+    while body > 0:
+        adr = model.body_jntadr[body]
+        if adr >= 0 and model.jnt_type[adr] == mujoco.mjtJoint.mjJNT_FREE:
+            return body
+        body = int(model.body_parentid[body])
+    raise ConfigError("a platform site is not on a free-floating board body")
+
+
+def _add_dead_weights(
+    spec: mujoco.MjSpec, mass: float, count: int, half_footprint: tuple[float, float]
+) -> list[str]:
+    """Steel boxes of ``mass / count`` each, one per platform, that only rest there by friction."""
+    each = mass / count
+    hx, hy = half_footprint
+    hz = each / (DEAD_WEIGHT_DENSITY * 8.0 * hx * hy)
+    names = []
+    for i in range(count):
+        name = f"dead_weight_{i}"
+        body = spec.worldbody.add_body(name=name, pos=[0.0, 0.0, 1.0 + i])
+        body.add_freejoint(name=f"{name}_root")
+        body.add_geom(
+            name=name,
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[hx, hy, hz],
+            mass=each,
+            contype=2,
+            conaffinity=1,
+            condim=3,
+            rgba=[0.6, 0.6, 0.65, 1.0],
+        )
+        names.append(name)
+    return names
+
+
+def build_scene(
+    robot: Robot | None,
+    physics_hz: int,
+    board: Board | None = None,
+    dead_weight: float | None = None,
+    foot_offset: tuple[float, float] = (0.0, 0.0),
+) -> Scene:
+    """Compile a rider on a board (or on flat ground) in a settled initial state.
 
     Args:
-        robot: The rider.
+        robot: The rider, or None for a dead weight.
         physics_hz: Physics rate [Hz].
+        board: The board, or None for flat ground.
+        dead_weight: Mass of the dead weight when ``robot`` is None [kg].
+        foot_offset: Feet (or weight) offset from the platform centre, (x, y) [m].
+
+    The rider's feet go over the board's platform site(s): a rigid board puts the centroid
+    of all feet over its one platform; independent platforms (Hovershoes) each move under
+    their foot. The lowest foot point starts ``FOOT_CLEARANCE`` above the support.
     """
-    spec = robot.spec()
+    if robot is None and (dead_weight is None or dead_weight <= 0.0):
+        raise ConfigError("a scene without a robot needs a positive dead-weight mass")
+    spec = robot.spec() if robot is not None else mujoco.MjSpec()
     for key in list(spec.keys):
         spec.delete(key)
     _add_world(spec, physics_hz)
-    _add_imu_sensors(spec, robot.params.imu_site)
+    if robot is not None:
+        _add_imu_sensors(spec, robot.params.imu_site)
+        rider_names = [robot.params.base_body]
+    platforms = board.params.platform_sites if board is not None else ()
+    if robot is None:
+        assert dead_weight is not None
+        footprint = DEAD_WEIGHT_HALF_FOOTPRINT if len(platforms) > 1 else (0.12, 0.09)
+        rider_names = _add_dead_weights(spec, dead_weight, max(1, len(platforms)), footprint)
+    if board is not None:
+        spec.attach(board.spec(), prefix=BOARD_PREFIX, frame=spec.worldbody.add_frame())
     model = spec.compile()
     data = mujoco.MjData(model)
 
     def body(name: str) -> int:
-        return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        found = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        if found < 0:
+            raise ConfigError(f"scene has no body '{name}'")
+        return found
 
-    base = body(robot.params.base_body)
-    robot_bodies = frozenset(b for b in range(1, model.nbody))
-    feet = frozenset(body(name) for name in robot.params.foot_bodies)
-    actuators = np.array(
-        [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, m.name) for m in robot.motors]
-    )
-    qpos = robot.stand_qpos.copy()
+    n_robot_q = robot.mj_model.nq if robot is not None else 0
+    n_robot_v = robot.mj_model.nv if robot is not None else 0
+    if robot is not None:
+        base = body(robot.params.base_body)
+        feet = [body(name) for name in robot.params.foot_bodies]
+        rider_bodies = frozenset(
+            b for b in range(1, model.nbody) if model.body_rootid[b] == model.body_rootid[base]
+        )
+        rider_mass = robot.mass
+        actuators = np.array(
+            [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, m.name) for m in robot.motors]
+        )
+    else:
+        feet = [body(name) for name in rider_names]
+        base = feet[0]
+        rider_bodies = frozenset(feet)
+        rider_mass = float(dead_weight or 0.0)
+        actuators = np.zeros(0, dtype=int)
+
+    qpos = model.qpos0.copy()
+    if robot is not None:
+        qpos[:n_robot_q] = robot.stand_qpos
     data.qpos[:] = qpos
     mujoco.mj_kinematics(model, data)
-    qpos[2] += FOOT_CLEARANCE - _lowest_point(model, data, feet)
+
+    board_bodies: frozenset[int] = frozenset()
+    board_roots: tuple[int, ...] = ()
+    board_ground: frozenset[int] = frozenset()
+    support = 0.0
+    if board is not None:
+        board_bodies = frozenset(
+            b
+            for b in range(1, model.nbody)
+            if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or "").startswith(
+                BOARD_PREFIX
+            )
+        )
+        board_ground = frozenset(body(BOARD_PREFIX + n) for n in board.params.ground_bodies)
+        sites = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, BOARD_PREFIX + n) for n in platforms
+        ]
+        if min(sites) < 0:
+            raise ConfigError(f"board '{board.name}': a platform site is missing from its model")
+        roots = [_free_root(model, int(model.site_bodyid[s])) for s in sites]
+        board_roots = tuple(dict.fromkeys(roots))
+        foot_xy = [_body_footprint_center(model, data, b) for b in feet]
+        offset = np.asarray(foot_offset)
+        if robot is None:  # each weight onto its platform
+            for site, weight in zip(sites, feet, strict=True):
+                _shift_root(
+                    model, qpos, weight, data.site_xpos[site, :2] + offset - data.xpos[weight, :2]
+                )
+        elif len(sites) == 1:  # a rigid board: the feet's centroid over its platform
+            shift = data.site_xpos[sites[0], :2] + offset - np.mean(foot_xy, axis=0)
+            _shift_root(model, qpos, base, shift)
+        elif len(sites) == len(feet):  # independent platforms, each under its foot
+            for site, root, xy in zip(sites, roots, foot_xy, strict=True):
+                _shift_root(model, qpos, root, xy - offset - data.site_xpos[site, :2])
+        else:
+            raise ConfigError(
+                f"board '{board.name}' has {len(sites)} platforms; the rider has {len(feet)} feet"
+            )
+        data.qpos[:] = qpos
+        mujoco.mj_kinematics(model, data)
+        support = float(max(data.site_xpos[s, 2] for s in sites))
+    for root in sorted({int(model.body_rootid[b]) for b in feet}):
+        lowest = _lowest_point(
+            model, data, frozenset(b for b in feet if model.body_rootid[b] == root)
+        )
+        _shift_root(model, qpos, root, np.zeros(2), support + FOOT_CLEARANCE - lowest)
     floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
     scene = Scene(
         model=model,
         data=data,
         robot=robot,
+        board=board,
         physics_hz=physics_hz,
-        robot_qpos=slice(0, robot.mj_model.nq),
-        robot_qvel=slice(0, robot.mj_model.nv),
+        robot_qpos=slice(0, n_robot_q),
+        robot_qvel=slice(0, n_robot_v),
         actuator_ids=actuators,
         base_body=base,
-        robot_bodies=robot_bodies,
-        foot_bodies=feet,
+        rider_mass=rider_mass,
+        rider_bodies=rider_bodies,
+        foot_bodies=frozenset(feet) if robot is not None else frozenset(),
+        board_bodies=board_bodies,
+        board_roots=board_roots,
+        board_ground_bodies=board_ground,
         ground_geoms=frozenset({floor}),
+        support_height=support,
         initial_qpos=qpos,
     )
     scene.reset()
     return scene
+
+
+def _body_footprint_center(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> np.ndarray:
+    """Horizontal centre of a body's collision geoms [m]."""
+    geoms = [
+        g for g in range(model.ngeom) if model.geom_bodyid[g] == body and model.geom_contype[g]
+    ]
+    points = [data.geom_xpos[g, :2] for g in geoms] or [data.xpos[body, :2]]
+    return np.mean(points, axis=0)
+
+
+def _shift_root(
+    model: mujoco.MjModel, qpos: np.ndarray, body: int, xy: np.ndarray, z: float = 0.0
+) -> None:
+    """Translate a free-floating body tree (by its root's free joint) in the world [m]."""
+    root = int(model.body_rootid[body])
+    adr = model.jnt_qposadr[model.body_jntadr[root]]
+    qpos[adr : adr + 2] += xy
+    qpos[adr + 2] += z

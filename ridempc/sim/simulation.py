@@ -5,8 +5,9 @@ Every physics step (``1 / physics_hz`` s), in this order:
 1. disturbances and parameter changes due now are applied;
 2. the VIO captures a sample if due (delivered later, after its latency);
 3. the rider controller runs if due, on a fresh sensor packet and the scenario's command;
-4. the motor drivers apply their PD law to the latest motor command;
-5. MuJoCo steps.
+4. the board's firmware runs if due, on the board's own sensors;
+5. the motor drivers apply their PD law to the latest motor command;
+6. MuJoCo steps.
 
 Controllers run every ``physics_hz / rate_hz`` steps exactly (see :mod:`ridempc.sim.clock`).
 The judge (fall detection, divergence checks, logging) reads the true state at
@@ -23,6 +24,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, SimulationDiverged
 from ridempc.scenarios.scenario import Disturbance, Scenario
@@ -30,7 +32,7 @@ from ridempc.sim.clock import Rate
 from ridempc.sim.falls import FallDetector
 from ridempc.sim.motors import MotorDriver
 from ridempc.sim.recorder import Recorder
-from ridempc.sim.scene import Scene
+from ridempc.sim.scene import BOARD_PREFIX, Scene
 from ridempc.sim.sensors import SensorSuite
 
 __all__ = ["RunResult", "Simulation"]
@@ -78,7 +80,7 @@ class Simulation:
 
     Args:
         scene: The compiled scene (reset to its initial state here).
-        controller: The rider controller.
+        controller: The rider controller (None when a dead weight rides).
         scenario: Duration, commands, disturbances, noise and changes.
         seed: Seed of every random draw in the run (sensor noise).
         ground_truth: Put ground truth in the sensor packets (debugging only).
@@ -90,7 +92,7 @@ class Simulation:
     def __init__(
         self,
         scene: Scene,
-        controller: Controller,
+        controller: Controller | None,
         scenario: Scenario,
         seed: int = 0,
         ground_truth: bool = False,
@@ -103,26 +105,37 @@ class Simulation:
         self.scenario = scenario
         self.seed = seed
         hz = scene.physics_hz
-        self.control_rate = Rate.of(controller.rate_hz, hz, "controller")
         self.log_rate = Rate.of(log_hz, hz, "log")
         self.frame_rate = Rate.of(frame_hz, hz, "video frame")
         self.on_frame = on_frame
         self.ground_truth = ground_truth
         robot = scene.robot
-        self.sensors = SensorSuite(
-            scene.model,
-            encoder_joints=robot.encoder_joints,
-            base_body=robot.params.base_body,
-            imu_site=robot.params.imu_site,
-            robot_qpos=scene.robot_qpos,
-            robot_qvel=scene.robot_qvel,
-            actuators=scene.actuator_ids,
-            noise=scenario.noise,
-            physics_hz=hz,
-            rng=np.random.default_rng(seed),
-            ground_truth=ground_truth,
-        )
-        self.driver = MotorDriver(scene.model, robot.motors, scene.actuator_ids)
+        if (robot is None) != (controller is None):
+            raise ConfigError("a robot needs a controller, and a dead weight takes none")
+        self.sensors: SensorSuite | None = None
+        self.driver: MotorDriver | None = None
+        if robot is not None and controller is not None:
+            self.control_rate = Rate.of(controller.rate_hz, hz, "controller")
+            self.sensors = SensorSuite(
+                scene.model,
+                encoder_joints=robot.encoder_joints,
+                base_body=robot.params.base_body,
+                imu_site=robot.params.imu_site,
+                robot_qpos=scene.robot_qpos,
+                robot_qvel=scene.robot_qvel,
+                actuators=scene.actuator_ids,
+                noise=scenario.noise,
+                physics_hz=hz,
+                rng=np.random.default_rng(seed),
+                ground_truth=ground_truth,
+            )
+            self.driver = MotorDriver(scene.model, robot.motors, scene.actuator_ids)
+        self.firmware: Firmware | None = None
+        if scene.board is not None:
+            io = BoardIO(scene.model, BOARD_PREFIX)
+            io.bind(scene.data)
+            self.firmware = scene.board.firmware(io)
+            self.firmware_rate = Rate.of(self.firmware.rate_hz, hz, "board firmware")
         self.falls = FallDetector(scene)
         self._pushes = [(self._body_of(d), d) for d in scenario.disturbances]
 
@@ -143,7 +156,7 @@ class Simulation:
 
     def _apply_disturbances(self, t: float, data: mujoco.MjData) -> None:
         data.xfrc_applied[:] = 0.0
-        mass = self.scene.robot.mass
+        mass = self.scene.rider_mass
         for body, push in self._pushes:
             if push.t <= t < push.t + push.duration:
                 scale = mass if push.per_kg else 1.0
@@ -179,10 +192,28 @@ class Simulation:
             yaw_rate=velocity[2],
             command_velocity=command.velocity,
             command_yaw_rate=command.yaw_rate,
-            qpos=data.qpos[scene.robot_qpos],
-            qvel=data.qvel[scene.robot_qvel],
-            motor_torque=self.driver.torque(data),
         )
+        if self.driver is not None:
+            recorder.append(
+                qpos=data.qpos[scene.robot_qpos],
+                qvel=data.qvel[scene.robot_qvel],
+                motor_torque=self.driver.torque(data),
+            )
+        if scene.board_roots:
+            board_velocity = np.empty((len(scene.board_roots), 6))
+            for i, body in enumerate(scene.board_roots):
+                mujoco.mj_objectVelocity(
+                    scene.model, data, mujoco.mjtObj.mjOBJ_BODY, body, board_velocity[i], 0
+                )
+            roots = list(scene.board_roots)
+            recorder.append(
+                board_position=data.xpos[roots],
+                board_quaternion=data.xquat[roots],
+                board_velocity=board_velocity[:, 3:],
+                board_angular_velocity=board_velocity[:, :3],
+            )
+        if self.firmware is not None:
+            recorder.append(**{f"firmware_{k}": v for k, v in self.firmware.diagnostics().items()})
 
     def _check_finite(self, t: float, data: mujoco.MjData) -> None:
         bad_acc = data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
@@ -193,6 +224,20 @@ class Simulation:
         speed = float(np.max(np.abs(data.qvel)))
         if speed > MAX_SPEED:
             raise SimulationDiverged(t, f"a velocity reached {speed:.3g} (limit {MAX_SPEED})")
+
+    def _control(self, tick: int, t: float, data: mujoco.MjData) -> float:
+        """One controller tick; returns its wall time [s]."""
+        assert self.sensors is not None and self.driver is not None and self.controller
+        packet = self.sensors.read(tick, data)
+        if tick == 0:
+            self.controller.reset(packet)
+        began = time.perf_counter()
+        command = self.controller.update(packet, self.scenario.command_at(t))
+        elapsed = time.perf_counter() - began
+        if not command.is_finite():
+            raise SimulationDiverged(t, "the controller returned a non-finite command")
+        self.driver.command = command
+        return elapsed
 
     def run(self) -> RunResult:
         """Run the scenario to its end, a fall or a failure."""
@@ -223,18 +268,13 @@ class Simulation:
                     break
                 self._apply_changes(tick, model)
                 self._apply_disturbances(t, data)
-                self.sensors.sample_vio(tick, data)
-                if self.control_rate.due(tick):
-                    packet = self.sensors.read(tick, data)
-                    if tick == 0:
-                        self.controller.reset(packet)
-                    began = time.perf_counter()
-                    command = self.controller.update(packet, self.scenario.command_at(t))
-                    times.append(time.perf_counter() - began)
-                    if not command.is_finite():
-                        raise SimulationDiverged(t, "the controller returned a non-finite command")
-                    self.driver.command = command
-                self.driver.apply(data)
+                if self.sensors is not None and self.driver is not None:
+                    self.sensors.sample_vio(tick, data)
+                    if self.control_rate.due(tick):
+                        times.append(self._control(tick, t, data))
+                    self.driver.apply(data)
+                if self.firmware is not None and self.firmware_rate.due(tick):
+                    self.firmware.update()
                 mujoco.mj_step(model, data)
         except SimulationDiverged as exc:
             result.status, result.error = "failed", str(exc)

@@ -1,0 +1,49 @@
+"""Board kinds: for each, its parameter model, its MuJoCo builder and its firmware.
+
+A kind is a subpackage of :mod:`ridempc.boards` exposing ``KIND``, a :class:`BoardKind`.
+The table below maps a kind's name to that subpackage; a board file names its kind.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from typing import NamedTuple
+
+import mujoco
+
+from ridempc.boards.firmware import BoardIO, Firmware
+from ridempc.boards.parameters import BoardParameters
+from ridempc.errors import UnknownNameError
+
+__all__ = ["BOARD_KINDS", "BoardKind", "board_kind"]
+
+
+class BoardKind(NamedTuple):
+    """What makes a kind of board.
+
+    Attributes:
+        parameters: Its checked parameter model (a :class:`BoardParameters` subclass).
+        build: Builds the board's own MuJoCo spec (bodies with free joints, wheel joints,
+            motors, the board's sensors, platform sites) from its parameters, unprefixed,
+            with the board resting on the ground at the world origin.
+        firmware: Makes the board's firmware from its parameters and I/O.
+    """
+
+    parameters: type[BoardParameters]
+    build: Callable[[BoardParameters], mujoco.MjSpec]
+    firmware: Callable[[BoardParameters, BoardIO], Firmware]
+
+
+BOARD_KINDS: dict[str, str] = {
+    "hovershoes": "ridempc.boards.hovershoes",
+    "segway": "ridempc.boards.segway",
+    "skateboard": "ridempc.boards.skateboard",
+}
+
+
+def board_kind(name: str) -> BoardKind:
+    if name not in BOARD_KINDS:
+        raise UnknownNameError("board kind", name, BOARD_KINDS)
+    kind: BoardKind = importlib.import_module(BOARD_KINDS[name]).KIND
+    return kind

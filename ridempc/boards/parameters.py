@@ -1,0 +1,76 @@
+"""Board parameter files (``boards/<name>/board.toml``): the board's one description.
+
+A board's MuJoCo body tree is built from these checked figures by its kind's builder
+(see :mod:`ridempc.boards.kinds`), and Pinocchio reads the MJCF that builder produces, so
+a second board of a kind (a bigger skateboard) is a new parameter file, not new code.
+
+Fields common to every board live in :class:`BoardParameters`; each kind subclasses it
+with its own figures (wheel radius, rake angles, ...), every one checked to be physical.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from ridempc.errors import ConfigError
+
+__all__ = [
+    "Angle",
+    "BoardParameters",
+    "NonNegative",
+    "Positive",
+    "read_board_toml",
+    "validate_board_parameters",
+]
+
+Positive = Annotated[float, Field(gt=0.0)]
+NonNegative = Annotated[float, Field(ge=0.0)]
+Angle = Annotated[float, Field(gt=0.0, lt=90.0, description="[deg], in (0, 90)")]
+
+
+class BoardParameters(BaseModel):
+    """What every board states.
+
+    Attributes:
+        name: Board name (its folder's name).
+        kind: Which builder, firmware and reduced model it uses (``hovershoes``, ...).
+        firmware_hz: Rate of the board's firmware [Hz] (a divisor of the physics rate).
+        platform_sites: Sites at the top centre of each platform, where the rider stands:
+            one for a rigid board, one per foot for independent platforms (Hovershoes).
+        ground_bodies: Bodies allowed to touch the ground (the wheels); any other board
+            body on the ground means the board fell.
+        dead_weight_robot: Robot whose mass the default dead weight has.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    name: str = Field(pattern=r"^[a-z0-9][a-z0-9_-]*$")
+    kind: str
+    firmware_hz: Positive
+    platform_sites: tuple[str, ...] = Field(min_length=1)
+    ground_bodies: tuple[str, ...] = Field(min_length=1)
+    dead_weight_robot: str
+
+
+def read_board_toml(path: Path) -> dict[str, object]:
+    try:
+        with open(path, "rb") as stream:
+            return tomllib.load(stream)
+    except FileNotFoundError as exc:
+        raise ConfigError(f"{path}: board parameter file not found") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
+
+
+def validate_board_parameters(
+    path: Path, raw: dict[str, object], model: type[BoardParameters]
+) -> BoardParameters:
+    """Check ``raw`` against a kind's parameter model, naming the bad field on failure."""
+    try:
+        return model.model_validate(raw)
+    except ValidationError as exc:
+        raise ConfigError.from_validation(path, exc) from exc
