@@ -8,12 +8,16 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import mujoco
 
 from ridempc.boards.firmware import BoardIO, Firmware
+from ridempc.boards.identification import IdentificationResult
 from ridempc.boards.parameters import BoardParameters
+
+if TYPE_CHECKING:
+    from ridempc.boards.board import Board
 from ridempc.errors import UnknownNameError
 
 __all__ = ["BOARD_KINDS", "BoardKind", "board_kind"]
@@ -28,11 +32,13 @@ class BoardKind(NamedTuple):
             motors, the board's sensors, platform sites) from its parameters, unprefixed,
             with the board resting on the ground at the world origin.
         firmware: Makes the board's firmware from its parameters and I/O.
+        identify: Identifies the kind's reduced model from simulated experiments on a board.
     """
 
     parameters: type[BoardParameters]
     build: Callable[[BoardParameters], mujoco.MjSpec]
     firmware: Callable[[BoardParameters, BoardIO], Firmware]
+    identify: Callable[[Board], IdentificationResult]
 
 
 BOARD_KINDS: dict[str, str] = {

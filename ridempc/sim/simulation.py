@@ -87,6 +87,9 @@ class Simulation:
         log_hz: Logging and judging rate [Hz].
         frame_hz: Rate of ``on_frame`` calls [Hz] (video).
         on_frame: Called with (model, data) at ``frame_hz``, e.g. to render video.
+        external: Called with (t, model, data) at every physics step after the scenario's
+            disturbances are set, to add scripted external forces to ``data.xfrc_applied``
+            (identification experiments).
     """
 
     def __init__(
@@ -99,7 +102,9 @@ class Simulation:
         log_hz: float = 100.0,
         frame_hz: float = 30.0,
         on_frame: Callable[[mujoco.MjModel, mujoco.MjData], None] | None = None,
+        external: Callable[[float, mujoco.MjModel, mujoco.MjData], None] | None = None,
     ) -> None:
+        self.external = external
         self.scene = scene
         self.controller = controller
         self.scenario = scenario
@@ -268,6 +273,8 @@ class Simulation:
                     break
                 self._apply_changes(tick, model)
                 self._apply_disturbances(t, data)
+                if self.external is not None:
+                    self.external(t, model, data)
                 if self.sensors is not None and self.driver is not None:
                     self.sensors.sample_vio(tick, data)
                     if self.control_rate.due(tick):
