@@ -45,7 +45,31 @@ def _parser() -> argparse.ArgumentParser:
     )
 
     commands.add_parser("list", help="name the robots, boards, controllers and scenarios")
+
+    board = commands.add_parser("board", help="board tools")
+    board_commands = board.add_subparsers(dest="board_command", required=True)
+    identify = board_commands.add_parser(
+        "identify", help="identify a board's reduced model from simulated experiments"
+    )
+    identify.add_argument("--board", required=True, help="board name")
+    identify.add_argument("--json", type=Path, default=None, help="also write the result here")
     return parser
+
+
+def _identify(args: argparse.Namespace) -> int:
+    import dataclasses
+
+    from ridempc.boards import load_board
+    from ridempc.io import atomic_write_json
+
+    board = load_board(args.board)
+    if board is None:
+        raise ConfigError("board 'none' (flat ground) has no reduced model to identify")
+    result = board.kind.identify(board)
+    print(result.table())
+    if args.json is not None:
+        atomic_write_json(args.json, dataclasses.asdict(result))
+    return 0
 
 
 def _list() -> int:
@@ -121,6 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "list":
             return _list()
+        if args.command == "board":
+            return _identify(args)
         return _sim(args)
     except (UnknownNameError, ConfigError) as exc:
         print(f"ridempc: error: {exc}", file=sys.stderr)
