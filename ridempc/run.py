@@ -61,24 +61,6 @@ class RideRequest:
     physics_hz: int = DEFAULT_PHYSICS_HZ
 
 
-def _viewer_callback(model: Any, data: Any) -> Any:
-    import time
-
-    import mujoco.viewer
-
-    handle = mujoco.viewer.launch_passive(model, data)
-    started = [time.perf_counter(), data.time]
-
-    def sync(model: Any, data: Any) -> None:
-        ahead = (data.time - started[1]) - (time.perf_counter() - started[0])
-        if ahead > 0:
-            time.sleep(ahead)
-        if handle.is_running():
-            handle.sync()
-
-    return sync
-
-
 def ride(request: RideRequest) -> dict[str, Any]:
     """Run one ride and write its results; returns the summary.
 
@@ -112,7 +94,8 @@ def ride(request: RideRequest) -> dict[str, Any]:
 
     scene = build_scene(robot, request.physics_hz, board=board, dead_weight=dead_weight)
     video = None
-    on_frame = None
+    viewer = None
+    on_frame: Any = None
     if request.video:
         from ridempc.sim.video import VideoRecorder
 
@@ -125,7 +108,9 @@ def ride(request: RideRequest) -> dict[str, Any]:
         )
         on_frame = video
     elif request.viewer:
-        on_frame = _viewer_callback(scene.model, scene.data)
+        from ridempc.sim.viewer import LiveViewer
+
+        viewer = on_frame = LiveViewer(scene.model, scene.data)
     simulation = Simulation(
         scene,
         controller,
@@ -139,6 +124,8 @@ def ride(request: RideRequest) -> dict[str, Any]:
     finally:
         if video is not None:
             video.close(keep=True)
+        if viewer is not None:
+            viewer.close()
 
     atomic_write_npz(out / "log.npz", result.log)
     files = ["log.npz"]
