@@ -10,13 +10,12 @@ with its own figures (wheel radius, rake angles, ...), every one checked to be p
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
-from ridempc.errors import ConfigError
+from ridempc.tomlfile import read_toml, validate
 
 __all__ = [
     "Angle",
@@ -56,21 +55,12 @@ class BoardParameters(BaseModel):
     dead_weight_robot: str
 
 
-def read_board_toml(path: Path) -> dict[str, object]:
-    try:
-        with open(path, "rb") as stream:
-            return tomllib.load(stream)
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: board parameter file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
+def read_board_toml(path: Path) -> dict[str, Any]:
+    return read_toml(path, "board parameter file")
 
 
 def validate_board_parameters(
-    path: Path, raw: dict[str, object], model: type[BoardParameters]
+    path: Path, raw: dict[str, Any], model: type[BoardParameters]
 ) -> BoardParameters:
     """Check ``raw`` against a kind's parameter model, naming the bad field on failure."""
-    try:
-        return model.model_validate(raw)
-    except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+    return validate(path, raw, model)

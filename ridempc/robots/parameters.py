@@ -13,13 +13,12 @@ A second robot of a class is a new folder with these two files, never new code.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from ridempc.errors import ConfigError
+from ridempc.tomlfile import load_checked
 
 __all__ = ["MotorParameters", "RobotParameters", "load_robot_parameters"]
 
@@ -83,14 +82,4 @@ def load_robot_parameters(path: Path) -> RobotParameters:
         ConfigError: The file is missing, is not TOML, or a field is missing or wrong;
             the message names the file and the field.
     """
-    try:
-        with open(path, "rb") as stream:
-            raw = tomllib.load(stream)
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: robot parameter file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
-    try:
-        return RobotParameters.model_validate(raw)
-    except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+    return load_checked(path, RobotParameters, "robot parameter file")

@@ -29,14 +29,13 @@ non-physical values are refused with the field named). Example::
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from ridempc.errors import ConfigError
 from ridempc.sim.sensors import SensorNoise
+from ridempc.tomlfile import load_checked
 
 __all__ = [
     "Command",
@@ -156,14 +155,4 @@ def load_scenario_file(path: Path) -> Scenario:
     Raises:
         ConfigError: Missing file, not TOML, or a bad field (named in the message).
     """
-    try:
-        with open(path, "rb") as stream:
-            raw = tomllib.load(stream)
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: scenario file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
-    try:
-        return Scenario.model_validate(raw)
-    except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+    return load_checked(path, Scenario, "scenario file")
