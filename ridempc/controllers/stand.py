@@ -1,15 +1,14 @@
-"""``stand``: hold the standing keyframe with each motor's joint PD.
+"""``stand``: hold the posture the robot starts in with each motor's joint PD.
 
-The simplest controller, to show the loop working: the motor targets are the
-description's ``stand`` keyframe and the gains are the robot's default low-level gains,
-:math:`\\tau = k_p (q_{stand} - q) - k_d \\dot q` [N m]. It uses no sensor but the
-encoders the drivers already read, and it does not balance: it stands only where the
-keyframe's centre of mass is over the feet.
+The simplest controller, to show the loop working. At the first tick it reads the motor
+joints' encoders (the robot starts in its description's stand keyframe, or its stance
+keyframe for the board) and from then on holds them with the robot's default low-level
+gains, :math:`\\tau = k_p (q_0 - q) - k_d \\dot q` [N m]. It does not balance: it stands
+only where that posture's centre of mass is over the feet.
 """
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from ridempc.controllers.base import Controller
@@ -26,13 +25,14 @@ class StandController(Controller):
 
     def __init__(self, robot: Robot) -> None:
         super().__init__(robot)
-        model = robot.mj_model
-        qpos = robot.stand_qpos
-        targets = []
-        for motor in robot.motors:
-            joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, motor.joint)
-            targets.append(qpos[model.jnt_qposadr[joint]])
-        self._hold = MotorCommand.hold(robot.motors, np.array(targets))
+        self._hold: MotorCommand | None = None
+
+    def reset(self, sensors: SensorPacket) -> None:
+        n = len(self.robot.motors)  # the motor joints lead the encoder list
+        self._hold = MotorCommand.hold(self.robot.motors, np.array(sensors.joint_position[:n]))
 
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        if self._hold is None:
+            self.reset(sensors)
+        assert self._hold is not None
         return self._hold

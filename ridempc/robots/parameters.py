@@ -61,6 +61,10 @@ class RobotParameters(_Frozen):
         default=(), description="Passive joints with encoders, besides the motor joints."
     )
     stand_keyframe: str = Field(default="stand", description="MJCF keyframe to start from.")
+    stance_keyframes: dict[str, str] = Field(
+        default_factory=dict,
+        description="Per board name, the keyframe to start from on that board (else the stand).",
+    )
     fall_height: PositiveFloat = Field(
         description="Base origin below this height over its support = fall [m]."
     )

@@ -108,12 +108,20 @@ class Robot:
     @cached_property
     def stand_qpos(self) -> NDArray[np.float64]:
         """Standing configuration from the description's keyframe [MuJoCo qpos]."""
+        return self.keyframe_qpos(self.params.stand_keyframe)
+
+    def stance_qpos(self, board: str) -> NDArray[np.float64]:
+        """The configuration to start from on ``board`` (the stand unless a stance is given)."""
+        return self.keyframe_qpos(
+            self.params.stance_keyframes.get(board, self.params.stand_keyframe)
+        )
+
+    def keyframe_qpos(self, name: str) -> NDArray[np.float64]:
+        """A keyframe of the description [MuJoCo qpos]."""
         model = self.mj_model
-        key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, self.params.stand_keyframe)
+        key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, name)
         if key < 0:
-            raise ConfigError(
-                f"{self.mjcf_path}: keyframe '{self.params.stand_keyframe}' not found"
-            )
+            raise ConfigError(f"{self.mjcf_path}: keyframe '{name}' not found")
         return np.array(model.key_qpos[key], dtype=float)
 
     @cached_property

@@ -2,7 +2,8 @@
 
 The rider fell when its base is below ``fall_height`` [m] over its starting support, or when
 one of its bodies that is not a foot touches the ground (for a dead weight: any of it).
-The board fell when one of its bodies other than the wheels touches the ground.
+The board fell when one of its bodies other than the wheels touches the ground. On a board,
+a rider's foot on the ground is a fall too: it stepped off.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ class FallDetector:
         self._fall_height = (
             scene.support_height + robot.params.fall_height if robot is not None else None
         )
-        self._forbidden = {b: "rider" for b in scene.rider_bodies - scene.foot_bodies} | {
+        allowed = frozenset() if scene.board is not None else scene.foot_bodies
+        self._forbidden = {b: "rider" for b in scene.rider_bodies - allowed} | {
             b: "board" for b in scene.board_bodies - scene.board_ground_bodies
         }
         self._ground = scene.ground_geoms

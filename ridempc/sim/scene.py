@@ -275,7 +275,7 @@ def build_scene(
 
     qpos = model.qpos0.copy()
     if robot is not None:
-        qpos[:n_robot_q] = robot.stand_qpos
+        qpos[:n_robot_q] = robot.stance_qpos(board.name if board is not None else "none")
     data.qpos[:] = qpos
     mujoco.mj_kinematics(model, data)
 

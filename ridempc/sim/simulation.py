@@ -38,7 +38,7 @@ from ridempc.sim.sensors import SensorSuite
 __all__ = ["RunResult", "Simulation"]
 
 Array = NDArray[np.float64]
-MAX_SPEED: float = 100.0  # [m/s or rad/s] any generalised velocity above this is an explosion
+MAX_SPEED: float = 1000.0  # [m/s or rad/s] a generalised velocity above this is an explosion
 
 
 @dataclass

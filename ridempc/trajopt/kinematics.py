@@ -48,7 +48,7 @@ def _axis_rotation(axis: np.ndarray, angle: Any) -> ca.SX:
     return ca.DM.eye(3) + ca.sin(angle) * skew + (1 - ca.cos(angle)) * (skew @ skew)
 
 
-def _joint_motion(joint: Any, q: ca.SX) -> tuple[ca.SX, ca.SX]:
+def _joint_motion(joint: Any, q: ca.SX) -> tuple[Any, Any]:
     """Rotation and translation of one joint at configuration ``q``."""
     kind = joint.shortname()
     i = joint.idx_q
@@ -76,9 +76,9 @@ def frame_kinematics(model: pin.Model, frames: list[str], name: str = "frames") 
         world position [m] (3 x 1) and rotation (3 x 3).
     """
     q = ca.SX.sym("q", model.nq)
-    cache: dict[int, tuple[ca.SX, ca.SX]] = {0: (ca.DM.eye(3), ca.DM.zeros(3))}
+    cache: dict[int, tuple[Any, Any]] = {0: (ca.DM.eye(3), ca.DM.zeros(3))}
 
-    def joint_pose(j: int) -> tuple[ca.SX, ca.SX]:
+    def joint_pose(j: int) -> tuple[Any, Any]:
         if j not in cache:
             parent_r, parent_p = joint_pose(model.parents[j])
             placement = model.jointPlacements[j]
