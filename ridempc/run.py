@@ -92,7 +92,13 @@ def ride(request: RideRequest) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     (out / "summary.json").unlink(missing_ok=True)
 
-    scene = build_scene(robot, request.physics_hz, board=board, dead_weight=dead_weight)
+    scene = build_scene(
+        robot,
+        request.physics_hz,
+        board=board,
+        dead_weight=dead_weight,
+        foot_offset=scenario.foot_offset,
+    )
     video = None
     viewer = None
     on_frame: Any = None

@@ -114,6 +114,7 @@ class Scenario(_Frozen):
     robots: tuple[str, ...] = ()  # robots it applies to; empty means any
     boards: tuple[str, ...] = ()  # boards it applies to; empty means any
     metrics_start: Time = 0.0  # tracking errors are measured from this time on [s]
+    foot_offset: tuple[float, float] = (0.0, 0.0)  # feet off the platform centre, (x, y) [m]
     commands: tuple[CommandEvent, ...] = ()
     disturbances: tuple[Disturbance, ...] = ()
     changes: tuple[ParameterChange, ...] = ()

@@ -324,6 +324,10 @@ def build_scene(
             model, data, frozenset(b for b in feet if model.body_rootid[b] == root)
         )
         _shift_root(model, qpos, root, np.zeros(2), support + FOOT_CLEARANCE - lowest)
+    if board is not None and robot is not None:
+        data.qpos[:] = qpos
+        mujoco.mj_kinematics(model, data)
+        _check_feet_over(model, data, robot, board, frozenset(board_bodies))
     floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
     scene = Scene(
         model=model,
@@ -347,6 +351,27 @@ def build_scene(
     )
     scene.reset()
     return scene
+
+
+def _check_feet_over(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    robot: Robot,
+    board: Board,
+    board_bodies: frozenset[int],
+) -> None:
+    """Every contact point must have the board right below it (a ray cast straight down)."""
+    down = np.array([0.0, 0.0, -1.0])
+    hit = np.zeros(1, dtype=np.int32)
+    for name in robot.params.contact_sites:
+        site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name)
+        start = data.site_xpos[site] + np.array([0.0, 0.0, 0.005])
+        distance = mujoco.mj_ray(model, data, start, down, None, True, model.site_bodyid[site], hit)
+        if distance < 0 or distance > 0.05 or model.geom_bodyid[hit[0]] not in board_bodies:
+            raise ConfigError(
+                f"{robot.name} does not fit on board '{board.name}': contact point '{name}' "
+                "is not over the platform"
+            )
 
 
 def _body_footprint_center(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> np.ndarray:

@@ -1,0 +1,67 @@
+"""Any robot on any board: feet on the platform(s), a settled start, no launch."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from ridempc.boards import board_names, load_board
+from ridempc.controllers import make_controller
+from ridempc.errors import ConfigError
+from ridempc.robots import load_robot, robot_names
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.scene import FOOT_CLEARANCE, build_scene
+from ridempc.sim.simulation import Simulation
+from tests.helpers import scenario
+
+BOARDS = [b for b in board_names() if b != "none"]
+PAIRS = [(r, b) for r in robot_names() for b in BOARDS]
+# The quadruped's four feet fit neither on two foot-sized shoes nor between a Segway's wheels.
+MISFITS = {("cyberdog2", "hovershoes"), ("cyberdog2", "segway")}
+MISSION = {"hovershoes": "cassie", "segway": "cassie", "skateboard": "cyberdog2"}
+
+
+@pytest.mark.parametrize(("robot_name", "board_name"), PAIRS)
+def test_rider_starts_settled_on_the_board(robot_name: str, board_name: str) -> None:
+    robot, board = load_robot(robot_name), load_board(board_name)
+    if (robot_name, board_name) in MISFITS:
+        with pytest.raises(ConfigError, match="platforms|does not fit"):
+            build_scene(robot, DEFAULT_PHYSICS_HZ, board=board)
+        return
+    scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board)
+    model, data = scene.model, scene.data
+    assert all(data.contact[i].dist > -1e-4 for i in range(data.ncon)), "interpenetration"
+    feet = scene.foot_bodies
+    # the feet start just above the platform, not on the floor
+    lowest = min(data.xpos[b, 2] for b in feet)
+    assert lowest > scene.support_height - 0.05
+    assert scene.support_height > 0.05
+    result = Simulation(scene, make_controller("stand", robot), scenario(0.3)).run()
+    assert result.status == "ok", result.fall_reason
+    speed = np.linalg.norm(result.log["base_velocity"], axis=1)
+    assert speed.max() < 0.5, "launched"
+    # the feet rest on the board: a contact between each foot and a board geom
+    board_geoms = {g for g in range(model.ngeom) if model.geom_bodyid[g] in scene.board_bodies}
+    touching = set()
+    for i in range(data.ncon):
+        g1, g2 = data.contact[i].geom
+        for foot_geom, other in ((g1, g2), (g2, g1)):
+            if model.geom_bodyid[foot_geom] in feet and other in board_geoms:
+                touching.add(int(model.geom_bodyid[foot_geom]))
+    assert touching == set(feet)
+    assert FOOT_CLEARANCE < 0.01
+
+
+@pytest.mark.parametrize("board_name", BOARDS)
+def test_feet_can_start_off_centre(board_name: str) -> None:
+    robot, board = load_robot(MISSION[board_name]), load_board(board_name)
+    centred = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board)
+    offset = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board, foot_offset=(0.03, 0.01))
+    site = mujoco.mj_name2id(
+        centred.model, mujoco.mjtObj.mjOBJ_SITE, "board/" + board.params.platform_sites[0]
+    )
+    relative = [
+        s.data.xpos[s.base_body, :2] - s.data.site_xpos[site, :2] for s in (centred, offset)
+    ]
+    assert np.allclose(relative[1] - relative[0], (0.03, 0.01), atol=1e-9)
