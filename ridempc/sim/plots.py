@@ -35,6 +35,20 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title:
             axes[3].plot(t, log["motor_torque"][:, i], lw=0.8, label=motor.name)
         axes[3].set_ylabel("motor torque [N m]")
         axes[3].legend(loc="upper right", fontsize=6, ncol=2)
+    else:  # a dead weight: show what the board's firmware commands instead
+        for key in sorted(k for k in log if k.startswith("firmware_") and k.endswith("torque")):
+            axes[3].plot(t, log[key], lw=0.8, label=key.removeprefix("firmware_"))
+        axes[3].set_ylabel("firmware wheel torque [N m]")
+        if axes[3].lines:
+            axes[3].legend(loc="upper right", fontsize=7)
+        else:
+            axes[3].text(
+                0.5,
+                0.5,
+                "passive board: no firmware output",
+                ha="center",
+                transform=axes[3].transAxes,
+            )
     if board:
         quat = log["board_quaternion"]
         w, x, y, z = (quat[..., i] for i in range(4))
