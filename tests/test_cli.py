@@ -166,3 +166,28 @@ def test_viewer_without_display_says_so(capsys, tmp_path: Path, monkeypatch) -> 
     )
     assert code == 0
     assert "needs a display" in err
+
+
+def test_board_identify_failure_writes_nothing(capsys, tmp_path: Path, monkeypatch) -> None:
+    from ridempc.boards import board as board_module
+    from ridempc.boards.identification import IdentificationFailed
+
+    def fail(board):
+        raise IdentificationFailed(f"{board.name}: roll fit did not converge")
+
+    real_kind = board_module.Board.kind.fget
+
+    def kind(self):
+        return real_kind(self)._replace(identify=fail)
+
+    monkeypatch.setattr(board_module.Board, "kind", property(kind))
+    target = tmp_path / "id.json"
+    code, _, err = _run(capsys, "board", "identify", "--board", "skateboard", "--json", str(target))
+    assert code == 1
+    assert "did not converge" in err and len(err.strip().splitlines()) == 1
+    assert not target.exists()
+
+
+def test_board_identify_unknown_board_exits_2(capsys) -> None:
+    code, _, err = _run(capsys, "board", "identify", "--board", "surfboard")
+    assert code == 2 and "surfboard" in err and "segway" in err
