@@ -76,24 +76,23 @@ def _list() -> int:
     from ridempc.boards import board_names
     from ridempc.controllers import controller_names
     from ridempc.robots import robot_names
-    from ridempc.scenarios import resolve_scenario, scenario_names
+    from ridempc.scenarios import scenario_applies, scenario_names
 
     print("robots:      " + ", ".join(robot_names()))
     print("boards:      " + ", ".join(board_names()))
     print("controllers: " + ", ".join(controller_names()))
-    print("scenarios:")
+    print(
+        "scenarios (robot 'none' with controller 'dead-weight' rides a board with a dead weight):"
+    )
+    riders = (*robot_names(), "none")
     for name in scenario_names():
-        scenario = resolve_scenario(name)
-        pairs = []
-        for robot in robot_names():
-            for board in board_names():
-                mark = "" if scenario.applies_to(robot, board) else " (n/a)"
-                pairs.append(f"{robot}/{board}{mark}")
-        print(f"  {name:<16} {scenario.description}")
-        print(f"  {'':<16} applies to: {', '.join(p for p in pairs if 'n/a' not in p)}")
-        skipped = [p.split(" ")[0] for p in pairs if "n/a" in p]
-        if skipped:
-            print(f"  {'':<16} does not apply to: {', '.join(skipped)}")
+        on = [b for b in board_names() if any(scenario_applies(name, r, b) for r in riders)]
+        off = [b for b in board_names() if b not in on]
+        robots = sorted({r for r in riders for b in on if scenario_applies(name, r, b)})
+        line = f"  {name:<16} boards: {', '.join(on)}"
+        if off:
+            line += f" (does not apply to: {', '.join(off)})"
+        print(line + f"; riders: {', '.join(robots)}")
     return 0
 
 

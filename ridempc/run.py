@@ -71,9 +71,9 @@ def ride(request: RideRequest) -> dict[str, Any]:
     """
     robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
     board = load_board(request.board)
-    scenario = resolve_scenario(request.scenario)
-    controller = make_controller(request.controller, robot)
     board_name = board.name if board is not None else NO_BOARD
+    scenario = resolve_scenario(request.scenario, board_name)
+    controller = make_controller(request.controller, robot)
     if not scenario.applies_to(request.robot, board_name):
         raise ConfigError(
             f"scenario '{scenario.name}' does not apply to {request.robot} on board '{board_name}'"
@@ -98,6 +98,7 @@ def ride(request: RideRequest) -> dict[str, Any]:
         board=board,
         dead_weight=dead_weight,
         foot_offset=scenario.foot_offset,
+        platform_offsets=scenario.platform_offsets,
     )
     video = None
     viewer = None

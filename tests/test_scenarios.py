@@ -7,14 +7,40 @@ from pathlib import Path
 import pytest
 
 from ridempc.errors import ConfigError, UnknownNameError
-from ridempc.scenarios import load_scenario_file, resolve_scenario, scenario_names
+from ridempc.scenarios import (
+    library_files,
+    load_scenario_file,
+    resolve_scenario,
+    scenario_applies,
+)
 
 
-@pytest.mark.parametrize("name", scenario_names())
-def test_every_library_scenario_loads(name: str) -> None:
-    scenario = resolve_scenario(name)
-    assert scenario.name == name
+@pytest.mark.parametrize("path", library_files(), ids=lambda p: f"{p.parent.name}/{p.stem}")
+def test_every_library_file_loads_under_its_name(path: Path) -> None:
+    scenario = load_scenario_file(path)
+    assert scenario.name == path.stem
     assert scenario.duration > 0
+    if path.parent.name != "library":  # a board's variant applies to that board only
+        assert scenario.boards == (path.parent.name,)
+
+
+def test_board_variants_resolve_by_board() -> None:
+    assert resolve_scenario("push", "skateboard").disturbances[1].body == "board/deck"
+    assert resolve_scenario("push", "none").disturbances[0].body == "base"
+    assert resolve_scenario("velocity-steps", "hovershoes").command_at(30.0).velocity == 1.5
+    assert resolve_scenario("velocity-steps", "segway").command_at(25.0).velocity == 4.0
+    with pytest.raises(ConfigError, match="does not apply to board 'skateboard'"):
+        resolve_scenario("wave", "skateboard")
+    assert scenario_applies("roll-tracking", "cyberdog2", "skateboard")
+    assert not scenario_applies("roll-tracking", "cassie", "skateboard")
+    assert not scenario_applies("wave", "cassie", "segway")
+
+
+def test_waves_add_a_sinusoid() -> None:
+    scenario = resolve_scenario("roll-tracking", "skateboard")
+    assert scenario.command_at(1.0).roll == 0.0
+    assert scenario.command_at(2.75).roll == pytest.approx(0.1)  # a quarter period in
+    assert scenario.command_at(4.25).roll == pytest.approx(-0.1)
 
 
 def test_unknown_scenario_names_the_valid_ones() -> None:

@@ -29,6 +29,7 @@ non-physical values are refused with the field named). Example::
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -40,6 +41,7 @@ from ridempc.tomlfile import load_checked
 __all__ = [
     "Command",
     "CommandEvent",
+    "CommandWave",
     "Disturbance",
     "ParameterChange",
     "Scenario",
@@ -60,7 +62,9 @@ class Command(_Frozen):
     Attributes:
         velocity: Forward speed in the heading frame [m/s].
         yaw_rate: Turning rate [rad/s], positive to the left.
-        lateral_offset: Lateral foot offset for the wave pattern [m].
+        lateral_offset: Change of each foot's lateral distance from the centre line, about the
+            stance (the hovershoe paper's :math:`y_{offset}` minus its nominal value) [m]; the
+            feet are :math:`2 \times` this further apart.
         roll: Board roll reference [rad].
     """
 
@@ -84,6 +88,22 @@ class CommandEvent(_Frozen):
         return {
             k: v for k, v in self.model_dump().items() if k not in ("t", "ramp") and v is not None
         }
+
+
+class CommandWave(_Frozen):
+    r"""A sinusoid added to one command field between ``start`` and ``stop``:
+    :math:`a \sin(2\pi (t - t_0) / T)` (the skateboard's roll reference, the wave pattern)."""
+
+    field: Literal["velocity", "yaw_rate", "lateral_offset", "roll"]
+    amplitude: float
+    period: Annotated[float, Field(gt=0.0)]  # [s]
+    start: Time = 0.0
+    stop: Annotated[float, Field(gt=0.0)] = 3600.0  # [s]
+
+    def value(self, t: float) -> float:
+        if not self.start <= t < self.stop:
+            return 0.0
+        return self.amplitude * math.sin(2.0 * math.pi * (t - self.start) / self.period)
 
 
 class Disturbance(_Frozen):
@@ -115,7 +135,9 @@ class Scenario(_Frozen):
     boards: tuple[str, ...] = ()  # boards it applies to; empty means any
     metrics_start: Time = 0.0  # tracking errors are measured from this time on [s]
     foot_offset: tuple[float, float] = (0.0, 0.0)  # feet off the platform centre, (x, y) [m]
+    platform_offsets: tuple[tuple[float, float], ...] = ()  # independent platforms moved [m]
     commands: tuple[CommandEvent, ...] = ()
+    waves: tuple[CommandWave, ...] = ()
     disturbances: tuple[Disturbance, ...] = ()
     changes: tuple[ParameterChange, ...] = ()
     noise: SensorNoise = SensorNoise()
@@ -144,6 +166,8 @@ class Scenario(_Frozen):
                     values[key] = values[key] + alpha * (target - values[key])
                 else:
                     values[key] = target
+        for wave in self.waves:
+            values[wave.field] += wave.value(t)
         return Command(**values)
 
     def with_duration(self, duration: float) -> Scenario:

@@ -6,6 +6,9 @@
 - ``yaw_rate_rmse`` [rad/s]: :math:`\\sqrt{\\overline{(\\dot\\psi - \\dot\\psi^*)^2}}`;
 - ``peak_torque`` [N m] per motor, and the largest ratio of peak to limit;
 - ``board_max_tilt`` [rad] and ``board_max_speed`` [m/s] of the board's platforms;
+- ``roll_rmse`` [rad]: the deck's roll against the commanded roll, where a roll is commanded;
+- ``foot_spacing_rmse`` [m]: for two independent platforms, their lateral distance across
+  the rider's heading against the starting spacing plus twice the commanded lateral offset;
 - ``base_height_drift`` [m]: final minus initial base height;
 - ``controller_update_ms``: median and p99 of the controller's update time.
 
@@ -32,6 +35,24 @@ def _tilt(quaternions: np.ndarray) -> np.ndarray:
     return np.arccos(np.clip(1.0 - 2.0 * (x**2 + y**2), -1.0, 1.0))
 
 
+def _roll(quaternions: np.ndarray) -> np.ndarray:
+    """Roll about the body's own x axis [rad] (z-y-x Euler angles), for (w, x, y, z)."""
+    w, x, y, z = (quaternions[:, i] for i in range(4))
+    return np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x**2 + y**2))
+
+
+def _lateral_spacing(positions: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Distance between two platforms across the rider's heading [m]."""
+    delta = positions[:, 0, :2] - positions[:, 1, :2]
+    return -np.sin(yaw) * delta[:, 0] + np.cos(yaw) * delta[:, 1]
+
+
+def _tracks(scenario: Scenario, field: str) -> bool:
+    """Whether the scenario commands ``field`` at all."""
+    events = any(getattr(e, field) not in (None, 0.0) for e in scenario.commands)
+    return events or any(w.field == field for w in scenario.waves)
+
+
 def _rmse(error: np.ndarray) -> float | None:
     return float(np.sqrt(np.mean(error**2))) if error.size else None
 
@@ -56,6 +77,13 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> d
             m.name: round(float(p), 3) for m, p in zip(robot.motors, peak, strict=True)
         }
         metrics["peak_torque_ratio"] = float(np.max(peak / limits))
+    if "board_quaternion" in log and _tracks(scenario, "roll"):
+        roll = _roll(log["board_quaternion"][:, 0])
+        metrics["roll_rmse"] = _rmse(roll[window] - log["command_roll"][window])
+    if "board_position" in log and log["board_position"].shape[1] == 2:
+        spacing = _lateral_spacing(log["board_position"], log["yaw"])
+        wanted = spacing[0] + 2.0 * log["command_lateral_offset"]
+        metrics["foot_spacing_rmse"] = _rmse(spacing[window] - wanted[window])
     if "board_quaternion" in log:
         metrics["board_max_tilt"] = float(np.max(_tilt(log["board_quaternion"])))
         metrics["board_max_speed"] = float(

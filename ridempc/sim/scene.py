@@ -215,6 +215,7 @@ def build_scene(
     board: Board | None = None,
     dead_weight: float | None = None,
     foot_offset: tuple[float, float] = (0.0, 0.0),
+    platform_offsets: tuple[tuple[float, float], ...] = (),
 ) -> Scene:
     """Compile a rider on a board (or on flat ground) in a settled initial state.
 
@@ -224,6 +225,8 @@ def build_scene(
         board: The board, or None for flat ground.
         dead_weight: Mass of the dead weight when ``robot`` is None [kg].
         foot_offset: Feet (or weight) offset from the platform centre, (x, y) [m].
+        platform_offsets: Per independent platform, a further shift of that platform, (x, y)
+            [m] (Hovershoes started staggered).
 
     The rider's feet go over the board's platform site(s): a rigid board puts the centroid
     of all feet over its one platform; independent platforms (Hovershoes) each move under
@@ -310,8 +313,14 @@ def build_scene(
             shift = data.site_xpos[sites[0], :2] + offset - np.mean(foot_xy, axis=0)
             _shift_root(model, qpos, base, shift)
         elif len(sites) == len(feet):  # independent platforms, each under its foot
-            for site, root, xy in zip(sites, roots, foot_xy, strict=True):
-                _shift_root(model, qpos, root, xy - offset - data.site_xpos[site, :2])
+            shifts = list(platform_offsets) or [(0.0, 0.0)] * len(sites)
+            if len(shifts) != len(sites):
+                raise ConfigError(
+                    f"{len(shifts)} platform offsets for {len(sites)} platforms of '{board.name}'"
+                )
+            for site, root, xy, extra in zip(sites, roots, foot_xy, shifts, strict=True):
+                target = xy - offset + np.asarray(extra)
+                _shift_root(model, qpos, root, target - data.site_xpos[site, :2])
         else:
             raise ConfigError(
                 f"board '{board.name}' has {len(sites)} platforms; the rider has {len(feet)} feet"

@@ -148,6 +148,8 @@ class SensorSuite:
         self._robot_qpos = robot_qpos
         self._robot_qvel = robot_qvel
         self._actuators = actuators
+        # MuJoCo's actuator_force is on the motor side of the gear; the packet holds joint side
+        self._gear = np.array(model.actuator_gear[actuators, 0])
         self._imu_quat = self._sensor_slice(model, f"{imu_site}_quat")
         self._imu_gyro = self._sensor_slice(model, f"{imu_site}_gyro")
         self._imu_acc = self._sensor_slice(model, f"{imu_site}_accel")
@@ -219,7 +221,7 @@ class SensorSuite:
             imu=imu,
             joint_position=q,
             joint_velocity=data.qvel[self._enc_dof] + self._noise(n.encoder_velocity_std, count),
-            motor_torque=data.actuator_force[self._actuators]
+            motor_torque=self._gear * data.actuator_force[self._actuators]
             + self._noise(n.torque_std, len(self._actuators)),
             vio=self._vio_latest,
             truth=truth,

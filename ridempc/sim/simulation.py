@@ -197,6 +197,8 @@ class Simulation:
             yaw_rate=velocity[2],
             command_velocity=command.velocity,
             command_yaw_rate=command.yaw_rate,
+            command_roll=command.roll,
+            command_lateral_offset=command.lateral_offset,
         )
         if self.driver is not None:
             recorder.append(
