@@ -73,7 +73,7 @@ def ride(request: RideRequest) -> dict[str, Any]:
     board = load_board(request.board)
     board_name = board.name if board is not None else NO_BOARD
     scenario = resolve_scenario(request.scenario, board_name)
-    controller = make_controller(request.controller, robot)
+    controller = make_controller(request.controller, robot, board_name)
     if not scenario.applies_to(request.robot, board_name):
         raise ConfigError(
             f"scenario '{scenario.name}' does not apply to {request.robot} on board '{board_name}'"

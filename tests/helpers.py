@@ -37,8 +37,8 @@ class RecordingController(StandController):
 
     rate_hz = 500.0
 
-    def __init__(self, robot) -> None:
-        super().__init__(robot)
+    def __init__(self, robot, board: str = "none") -> None:
+        super().__init__(robot, board)
         self.packets: list[SensorPacket] = []
 
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:

@@ -29,8 +29,9 @@ class Controller(ABC):
     rate_hz: float = 500.0
     uses_ground_truth: bool = False
 
-    def __init__(self, robot: Robot) -> None:
+    def __init__(self, robot: Robot, board: str = "none") -> None:
         self.robot = robot
+        self.board = board  # the board's name ("none" on flat ground)
 
     def reset(self, sensors: SensorPacket) -> None:  # noqa: B027 - optional hook
         """Called once with the first sensor packet, before the first :meth:`update`."""

@@ -14,7 +14,8 @@ __all__ = ["CONTROLLERS", "DEAD_WEIGHT", "NO_ROBOT", "controller_names", "make_c
 NO_ROBOT = "none"  # the robot name of a board ridden by a dead weight
 DEAD_WEIGHT = "dead-weight"  # the controller of a dead weight: none at all
 
-CONTROLLERS: dict[str, Callable[[Robot], Controller]] = {
+# name -> factory(robot, board name)
+CONTROLLERS: dict[str, Callable[[Robot, str], Controller]] = {
     "stand": StandController,
 }
 
@@ -23,8 +24,8 @@ def controller_names() -> tuple[str, ...]:
     return (*sorted(CONTROLLERS), DEAD_WEIGHT)
 
 
-def make_controller(name: str, robot: Robot | None) -> Controller | None:
-    """The named controller for ``robot``; None for a dead weight (``--robot none``).
+def make_controller(name: str, robot: Robot | None, board: str = "none") -> Controller | None:
+    """The named controller for ``robot`` on ``board``; None for a dead weight.
 
     Raises:
         UnknownNameError: No such controller.
@@ -38,4 +39,4 @@ def make_controller(name: str, robot: Robot | None) -> Controller | None:
                 f"controller '{DEAD_WEIGHT}' goes with robot '{NO_ROBOT}' and only with it"
             )
         return None
-    return CONTROLLERS[name](robot)
+    return CONTROLLERS[name](robot, board)

@@ -23,8 +23,8 @@ __all__ = ["StandController"]
 class StandController(Controller):
     rate_hz = 500.0
 
-    def __init__(self, robot: Robot) -> None:
-        super().__init__(robot)
+    def __init__(self, robot: Robot, board: str = "none") -> None:
+        super().__init__(robot, board)
         self._hold: MotorCommand | None = None
 
     def reset(self, sensors: SensorPacket) -> None:
