@@ -9,11 +9,15 @@ A controller runs at its own rate (a divisor of the physics rate), reads only a
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING
 
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
+
+if TYPE_CHECKING:
+    from ridempc.estimation.state import EstimatedState
 
 __all__ = ["Controller"]
 
@@ -43,3 +47,11 @@ class Controller(ABC):
     def diagnostics(self) -> dict[str, float]:
         """Scalars to log at this tick (solve times, modes, ...)."""
         return {}
+
+    def estimate(self) -> EstimatedState | None:
+        """The controller's latest state estimate, for the judge to log against the truth.
+
+        None for a controller without an estimator (the default), and before its first
+        tick. A controller that overrides this is logged with NaN rows until it has one.
+        """
+        return None

@@ -10,6 +10,10 @@
 - ``foot_spacing_rmse`` [m]: for two independent platforms, their lateral distance across
   the rider's heading against the starting spacing plus twice the commanded lateral offset;
 - ``base_height_drift`` [m]: final minus initial base height;
+- ``estimator_velocity_rmse`` [m/s] and ``estimator_position_rmse`` [m]: the controller's
+  state estimate of the base velocity and position against the truth,
+  :math:`\\sqrt{\\overline{\\|\\hat v - v\\|^2}}`, over the whole run (rows with an estimate),
+  when the controller has an estimator;
 - ``controller_update_ms``: median and p99 of the controller's update time.
 
 Both RMSEs are taken over the samples from the scenario's ``metrics_start`` until the
@@ -57,6 +61,19 @@ def _rmse(error: np.ndarray) -> float | None:
     return float(np.sqrt(np.mean(error**2))) if error.size else None
 
 
+def _estimator_errors(log: dict[str, np.ndarray]) -> dict[str, float | None]:
+    """RMS norm of the estimate's base velocity and position errors [m/s], [m]."""
+    rows = np.isfinite(log["estimate_base_velocity"]).all(axis=1)
+    errors: dict[str, float | None] = {}
+    for name, estimate, truth in (
+        ("estimator_velocity_rmse", "estimate_base_velocity", "base_velocity"),
+        ("estimator_position_rmse", "estimate_base_position", "base_position"),
+    ):
+        error = np.linalg.norm(log[estimate][rows] - log[truth][rows], axis=1)
+        errors[name] = _rmse(error)
+    return errors
+
+
 def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> dict[str, Any]:
     log = result.log
     if not log:
@@ -89,6 +106,8 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> d
         metrics["board_max_speed"] = float(
             np.max(np.linalg.norm(log["board_velocity"][..., :2], axis=-1))
         )
+    if "estimate_base_velocity" in log:
+        metrics.update(_estimator_errors(log))
     if result.controller_times.size:
         ms = 1e3 * result.controller_times
         metrics["controller_update_ms"] = {

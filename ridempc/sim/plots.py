@@ -1,4 +1,5 @@
-"""PNG plots of a run's log: base height, speed and yaw rate against their commands, torques."""
+"""PNG plots of a run's log: base height, speed and yaw rate against their commands, torques,
+the controller's state estimate against the truth (when it has one) and the board's tilt."""
 
 from __future__ import annotations
 
@@ -19,7 +20,9 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title:
 
     t = log["time"]
     board = "board_quaternion" in log
-    fig, axes = plt.subplots(5 if board else 4, 1, figsize=(9, 12 if board else 10), sharex=True)
+    estimate = "estimate_base_velocity" in log
+    rows = 4 + board + estimate
+    fig, axes = plt.subplots(rows, 1, figsize=(9, 2.5 * rows), sharex=True)
     axes[0].plot(t, log["base_position"][:, 2])
     axes[0].set_ylabel("rider base height [m]")
     axes[1].plot(t, log["forward_velocity"], label="measured (true)")
@@ -49,6 +52,8 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title:
                 ha="center",
                 transform=axes[3].transAxes,
             )
+    if estimate:
+        _plot_estimate(axes[4], t, log)
     if board:
         quat = log["board_quaternion"]
         w, x, y, z = (quat[..., i] for i in range(4))
@@ -67,3 +72,24 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title:
     fig.savefig(tmp, dpi=90)
     plt.close(fig)
     tmp.replace(path)
+
+
+def _plot_estimate(ax, t: np.ndarray, log: dict[str, np.ndarray]) -> None:
+    """The controller's estimate of the base velocity (dashed) against the truth (solid)."""
+    truth, estimate = log["base_velocity"], log["estimate_base_velocity"]
+    for i, (axis, colour) in enumerate(zip("xyz", ("C0", "C1", "C2"), strict=True)):
+        ax.plot(t, truth[:, i], color=colour, lw=0.9, label=f"{axis} true")
+        ax.plot(t, estimate[:, i], color=colour, lw=0.9, ls="--", label=f"{axis} estimate")
+    rows = np.isfinite(estimate).all(axis=1)
+    velocity = np.linalg.norm(estimate[rows] - truth[rows], axis=1)
+    position = np.linalg.norm(
+        log["estimate_base_position"][rows] - log["base_position"][rows], axis=1
+    )
+    if rows.any():
+        ax.set_title(
+            f"estimator error (RMS): velocity {np.sqrt(np.mean(velocity**2)):.3f} m/s, "
+            f"position {np.sqrt(np.mean(position**2)):.3f} m",
+            fontsize=8,
+        )
+    ax.set_ylabel("base velocity [m/s]")
+    ax.legend(loc="upper right", fontsize=6, ncol=3)

@@ -11,7 +11,9 @@ Every physics step (``1 / physics_hz`` s), in this order:
 
 Controllers run every ``physics_hz / rate_hz`` steps exactly (see :mod:`ridempc.sim.clock`).
 The judge (fall detection, divergence checks, logging) reads the true state at
-``log_hz``; nothing it reads reaches the controller. Runs are deterministic for a seed.
+``log_hz``; nothing it reads reaches the controller. It also logs the controller's state
+estimate (``Controller.estimate``), if it has one, next to the truth, to measure it.
+Runs are deterministic for a seed.
 """
 
 from __future__ import annotations
@@ -142,6 +144,10 @@ class Simulation:
             self.firmware = scene.board.firmware(io)
             self.firmware_rate = Rate.of(self.firmware.rate_hz, hz, "board firmware")
         self.falls = FallDetector(scene)
+        # a controller with an estimator gets its estimate logged next to the truth
+        self._logs_estimate = (
+            controller is not None and type(controller).estimate is not Controller.estimate
+        )
         self._pushes = [(self._body_of(d), d) for d in scenario.disturbances]
 
     def _body_of(self, disturbance: Disturbance) -> int:
@@ -221,6 +227,28 @@ class Simulation:
             )
         if self.firmware is not None:
             recorder.append(**{f"firmware_{k}": v for k, v in self.firmware.diagnostics().items()})
+        if self._logs_estimate:
+            self._log_estimate(recorder)
+
+    def _log_estimate(self, recorder: Recorder) -> None:
+        """The controller's latest estimate (from its last tick, before this row), or NaN."""
+        assert self.controller is not None
+        estimate = self.controller.estimate()
+        if estimate is None:
+            nan3 = np.full(3, np.nan)
+            recorder.append(
+                estimate_time=np.nan,
+                estimate_base_position=nan3,
+                estimate_base_velocity=nan3,
+                estimate_yaw=np.nan,
+            )
+            return
+        recorder.append(
+            estimate_time=estimate.time,
+            estimate_base_position=estimate.base_position,
+            estimate_base_velocity=estimate.base_velocity,
+            estimate_yaw=estimate.yaw,
+        )
 
     def _check_finite(self, t: float, data: mujoco.MjData) -> None:
         bad_acc = data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number

@@ -1,0 +1,103 @@
+"""A board's state from the rider's own feet, as the skateboard paper estimates it.
+
+The feet standing on a board move with it, so the board's platform frame is read off the
+stance feet's contact points :math:`c_k` (world, [m]) and velocities:
+
+- origin: their centroid :math:`\\bar c`;
+- normal :math:`n`: the least-squares plane through the points (the right singular vector
+  of the centred points with the smallest singular value), turned upward. With the
+  points on one line (two point feet, one line foot) the tilt about that line is not
+  seen by the feet: the normal is then taken perpendicular to the line and as close to
+  ``up_hint`` as possible (the world's z by default, or e.g. a line foot's sole normal);
+- x axis: the rider's forward direction projected on the plane; y = z × x;
+- yaw, pitch, roll: z-y-x Euler angles of :math:`R_{WP} = [x\\ y\\ z]`; with two feet side
+  by side, roll is the slope of the line through them, as in the paper;
+- velocity: the mean of the stance feet's world velocities :math:`\\bar{\\dot c}` [m/s];
+- yaw rate: from the relative velocity of the feet about the centroid,
+  :math:`\\dot\\psi = \\sum_k (r_k \\times \\dot r_k)_z / \\sum_k \\|r_k\\|_{xy}^2` with
+  :math:`r_k = c_k - \\bar c` projected on the ground.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.estimation.rotations import rpy_of_matrix
+from ridempc.estimation.state import BoardEstimate
+
+__all__ = ["estimate_board"]
+
+Array = NDArray[np.float64]
+COLLINEAR: float = 1e-3  # [m] RMS distance from the best line below which points are a line
+
+
+def _normal(points: Array, up_hint: Array) -> Array:
+    centred = points - points.mean(axis=0)
+    if len(points) >= 2:
+        _, singular, vt = np.linalg.svd(centred, full_matrices=True)
+    else:
+        singular, vt = np.zeros(1), np.eye(3)
+    second = singular[1] if singular.size > 1 else 0.0
+    if len(points) >= 3 and second / np.sqrt(len(points)) > COLLINEAR:
+        normal = vt[2]
+    elif len(points) >= 2 and singular[0] > 0.0:
+        line = vt[0]
+        normal = up_hint - line * (line @ up_hint)
+    else:
+        normal = up_hint.copy()
+    normal /= np.linalg.norm(normal)
+    return normal if normal[2] >= 0.0 else -normal
+
+
+def estimate_board(
+    feet: tuple[str, ...],
+    contact_points: Array,
+    velocities: Array,
+    forward: Array,
+    up_hint: Array | None = None,
+) -> BoardEstimate:
+    """The platform state from the points of the feet on it.
+
+    Args:
+        feet: Names of the feet the points belong to (recorded in the estimate).
+        contact_points: Contact points of those feet [m], world, shape (points, 3).
+        velocities: World velocity of each point [m/s], shape (points, 3).
+        forward: The rider's forward direction in the world (e.g. the base x axis).
+        up_hint: Normal to use about a line of points (default world z).
+
+    Raises:
+        ValueError: No points, or ``forward`` is along the normal.
+    """
+    points = np.asarray(contact_points, dtype=float).reshape(-1, 3)
+    if points.shape[0] == 0:
+        raise ValueError("a board estimate needs at least one foot contact point")
+    velocities = np.asarray(velocities, dtype=float).reshape(-1, 3)
+    hint = np.array([0.0, 0.0, 1.0]) if up_hint is None else np.asarray(up_hint, dtype=float)
+    z_axis = _normal(points, hint)
+    x_axis = forward - z_axis * (z_axis @ forward)
+    norm = np.linalg.norm(x_axis)
+    if norm < 1e-6:
+        raise ValueError("the rider's forward direction is normal to the board")
+    x_axis /= norm
+    rotation = np.column_stack([x_axis, np.cross(z_axis, x_axis), z_axis])
+    roll, pitch, yaw = rpy_of_matrix(rotation)
+    centre = points.mean(axis=0)
+    mean_velocity = velocities.mean(axis=0)
+    r = (points - centre)[:, :2]
+    r_dot = (velocities - mean_velocity)[:, :2]
+    spread = float(np.sum(r**2))
+    yaw_rate = (
+        float(np.sum(r[:, 0] * r_dot[:, 1] - r[:, 1] * r_dot[:, 0]) / spread)
+        if spread > 1e-6
+        else 0.0
+    )
+    return BoardEstimate(
+        feet=feet,
+        position=centre,
+        yaw=yaw,
+        pitch=pitch,
+        roll=roll,
+        velocity=mean_velocity,
+        yaw_rate=yaw_rate,
+    )

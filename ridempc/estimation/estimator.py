@@ -1,0 +1,277 @@
+"""The 500 Hz state estimator: IMU attitude, encoder joints, leg odometry fused with the VIO.
+
+Each tick, from one :class:`~ridempc.sim.sensors.SensorPacket` (never its ``truth``):
+
+1. **Attitude** (:mod:`~ridempc.estimation.imu`): :math:`R_{WB} = R_{WS} R_{BS}^\\top`,
+   :math:`\\omega_B = R_{BS}\\, \\omega_S` and the IMU point's acceleration
+   :math:`a = R_{WS} f_S + g`, with the IMU's placement read from the description.
+2. **Joints** (:mod:`~ridempc.estimation.joints`, :mod:`~ridempc.estimation.loop_closure`):
+   the encoders, and the unmeasured joints of closed chains solved from their closure.
+3. **Legs** (:mod:`~ridempc.estimation.legs`): each foot's position and velocity relative
+   to the base, and the IMU point's.
+4. **Contact** (:mod:`~ridempc.estimation.contact`): each foot's load from spring
+   deflection or joint torques, through a Schmitt trigger.
+5. **Filter** (:mod:`~ridempc.estimation.leg_odometry`, :mod:`~ridempc.estimation.kalman`):
+   predict with :math:`a`; update with the stance feet's kinematics; when a new VIO sample
+   has arrived, update with it against the state at its capture stamp
+   (:mod:`~ridempc.estimation.history`).
+6. **Board** (:mod:`~ridempc.estimation.board`): when told which feet stand on a board,
+   each platform's pose and velocity from those of its feet in contact (from all of them
+   when none is).
+
+Orientation comes from the IMU alone: the simulated IMU's orientation error is white,
+with no drift to correct, so the VIO's yaw is not used.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from types import MappingProxyType
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ridempc.errors import ConfigError
+from ridempc.estimation.board import estimate_board
+from ridempc.estimation.contact import ContactDetector, build_contact_detector
+from ridempc.estimation.history import HistoryEntry, StateHistory
+from ridempc.estimation.imu import BaseAttitude, ImuMount
+from ridempc.estimation.joints import JointMap
+from ridempc.estimation.kalman import LinearKalmanFilter
+from ridempc.estimation.leg_odometry import LegOdometryModel
+from ridempc.estimation.legs import LegKinematics, LegReading
+from ridempc.estimation.loop_closure import LoopClosure
+from ridempc.estimation.parameters import EstimatorParameters
+from ridempc.estimation.state import EstimatedState
+from ridempc.robots.pinocchio_model import PinocchioRobot, build_pinocchio_robot
+from ridempc.robots.robot import Robot
+from ridempc.sim.sensors import SensorPacket, VioReading
+
+__all__ = ["StateEstimator"]
+
+Array = NDArray[np.float64]
+
+
+class StateEstimator:
+    """Estimates the rider's state from its sensor packets.
+
+    Args:
+        robot: The robot.
+        params: Noise model and thresholds.
+        platforms: The feet standing on each moving board platform (one group per platform:
+            the skateboard's deck, each hovershoe). Their support velocity is free, and
+            :attr:`EstimatedState.boards` holds one estimate per group. Empty on the ground.
+        pinocchio: The robot's Pinocchio model (built from ``robot`` if not given).
+
+    Raises:
+        ConfigError: A name in ``platforms`` is not a foot or is in two groups, or the
+            robot's description does not suit the chosen contact signal.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        params: EstimatorParameters | None = None,
+        platforms: Sequence[Sequence[str]] = (),
+        pinocchio: PinocchioRobot | None = None,
+    ) -> None:
+        self.robot = robot
+        self.params = params or EstimatorParameters()
+        self.pinocchio = pinocchio or build_pinocchio_robot(robot)
+        self.model: pin.Model = pin.Model(self.pinocchio.model)  # a copy: closures add frames
+        self.mount = ImuMount.from_pinocchio(self.pinocchio, robot.params.imu_site)
+        self.joints = JointMap.build(self.model, robot.encoder_joints)
+        self.closure = LoopClosure.build(
+            self.model, self.pinocchio.constraints, self.joints.unmeasured_v
+        )
+        self.data: pin.Data = self.model.createData()
+        self.legs = LegKinematics.build(robot, self.pinocchio)
+        feet = self.legs.names
+        on_board = [f for group in platforms for f in group]
+        unknown = [f for f in on_board if f not in feet]
+        if unknown:
+            raise ConfigError(
+                f"platform foot '{unknown[0]}' is not a foot (valid: {', '.join(feet)})"
+            )
+        if len(set(on_board)) != len(on_board):
+            raise ConfigError(f"a foot stands on two platforms: {[list(g) for g in platforms]}")
+        self.platforms = tuple(tuple(group) for group in platforms if group)
+        self._on_ground = np.array([f not in on_board for f in feet])
+        self._platform_sites = tuple(
+            np.isin(self.legs.site_foot, [feet.index(f) for f in group]) for group in self.platforms
+        )
+        self.contact: ContactDetector = build_contact_detector(
+            robot, self.pinocchio, self.legs, self.params
+        )
+        self.odometry = LegOdometryModel(len(feet), self.params)
+        self.history = StateHistory(self.params.history)
+        self._q_guess = self.pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
+        self.filter = LinearKalmanFilter(np.zeros(self.odometry.size), np.eye(self.odometry.size))
+        self._time = 0.0
+        self._acceleration = np.zeros(3)
+        self._vio_stamp: float | None = None
+        self.state: EstimatedState | None = None
+        self.rejected_feet = 0  # stance-foot velocities left out as outliers, since reset
+
+    def _sense(self, packet: SensorPacket) -> tuple[BaseAttitude, Array, Array, LegReading]:
+        """Steps 1-3: attitude, joints and legs of one packet."""
+        imu = packet.imu
+        attitude = self.mount.attitude(
+            imu.quaternion, imu.angular_velocity, imu.linear_acceleration
+        )
+        q = self._q_guess.copy()
+        v = np.zeros(self.model.nv)
+        self.joints.write(
+            q,
+            v,
+            attitude.quaternion,
+            attitude.angular_velocity,
+            packet.joint_position,
+            packet.joint_velocity,
+        )
+        if self.closure.active:
+            q, v = self.closure.solve(self.model, self.data, q, v)
+            self._q_guess = q
+        else:
+            pin.computeJointJacobians(self.model, self.data, q)
+        return attitude, q, v, self.legs.read(self.model, self.data, v)
+
+    def reset(self, packet: SensorPacket, base_position: Array | None = None) -> EstimatedState:
+        """Start from the first packet, the robot at rest.
+
+        Args:
+            packet: The first sensor packet.
+            base_position: Prior base position [m], held with the parameters' wide initial
+                standard deviations. Default: the VIO's if a sample has arrived (held at
+                the VIO's), otherwise horizontal zero with the lowest contact point on a
+                support at :math:`z = 0`.
+        """
+        attitude, q, v, legs = self._sense(packet)
+        self.contact.contact[:] = True
+        stance = self.contact.update(
+            self.model, self.data, q, packet.joint_position, packet.motor_torque, legs
+        )
+        from_vio = base_position is None and packet.vio is not None
+        if base_position is not None:
+            prior = np.asarray(base_position, dtype=float)
+        elif packet.vio is not None:
+            prior = np.array(packet.vio.position, dtype=float)
+        else:
+            prior = np.array([0.0, 0.0, -float(np.min(legs.site_position[:, 2]))])
+        x, P = self.odometry.initial_state(
+            prior + legs.imu_position,
+            np.zeros(3),
+            legs.foot_position - legs.imu_position,
+            height_known=from_vio,
+        )
+        self.filter = LinearKalmanFilter(x, P)
+        self.history.clear()
+        self.rejected_feet = 0
+        self._time = packet.time
+        self._acceleration = attitude.imu_acceleration
+        self._vio_stamp = packet.vio.stamp if packet.vio is not None else None
+        self.history.append(
+            HistoryEntry(packet.time, x.copy(), legs.imu_position, legs.imu_velocity)
+        )
+        self.state = self._output(packet.time, attitude, q, v, legs, stance)
+        return self.state
+
+    def update(self, packet: SensorPacket) -> EstimatedState:
+        """One estimator tick (calls :meth:`reset` on the first packet)."""
+        if self.state is None:
+            return self.reset(packet)
+        attitude, q, v, legs = self._sense(packet)
+        stance = self.contact.update(
+            self.model, self.data, q, packet.joint_position, packet.motor_torque, legs
+        )
+        dt = packet.time - self._time
+        if dt > 0.0:
+            acceleration = 0.5 * (self._acceleration + attitude.imu_acceleration)
+            self.filter.predict(*self.odometry.process(dt, acceleration, stance, self._on_ground))
+        self._time, self._acceleration = packet.time, attitude.imu_acceleration
+        leg = self.odometry.legs(
+            legs.foot_position - legs.imu_position,
+            legs.foot_velocity - legs.imu_velocity,
+            stance,
+        )
+        _, rejected = self.filter.update(
+            leg.H, leg.z, leg.R, gated=leg.gated, gate=self.params.velocity_gate
+        )
+        self.rejected_feet += rejected
+        self.history.append(
+            HistoryEntry(packet.time, self.filter.x.copy(), legs.imu_position, legs.imu_velocity)
+        )
+        vio = packet.vio
+        if vio is not None and vio.stamp != self._vio_stamp:
+            self._vio_stamp = vio.stamp
+            self._fuse_vio(vio)
+        self.state = self._output(packet.time, attitude, q, v, legs, stance)
+        return self.state
+
+    def _fuse_vio(self, vio: VioReading) -> None:
+        """Fuse a VIO sample against the state at its capture stamp."""
+        past = self.history.at(vio.stamp)
+        if past is None:  # older than the history: too late to use
+            return
+        measurement = self.odometry.vio(
+            vio.position + past.imu_offset, vio.velocity + past.imu_offset_rate
+        )
+        correction, _ = self.filter.update(
+            measurement.H, measurement.z, measurement.R, predicted=past.x[:6]
+        )
+        self.history.shift_after(vio.stamp, correction)
+
+    def _output(
+        self,
+        time: float,
+        attitude: BaseAttitude,
+        q: Array,
+        v: Array,
+        legs: LegReading,
+        stance: NDArray[np.bool_],
+    ) -> EstimatedState:
+        x = self.filter.x
+        base_position = x[:3] - legs.imu_position
+        base_velocity = x[3:6] - legs.imu_velocity
+        q = q.copy()
+        v = v.copy()
+        q[:3] = base_position
+        v[:3] = attitude.rotation.T @ base_velocity
+        feet = np.array([x[self.odometry.foot_position(i)] for i in range(len(self.legs.feet))])
+        boards = []
+        stance_sites = stance[self.legs.site_foot]
+        names = self.legs.names
+        for group, sites in zip(self.platforms, self._platform_sites, strict=True):
+            if np.any(sites & stance_sites):  # the feet in the air say nothing of the board
+                sites = sites & stance_sites
+                group = tuple(f for f in group if stance[names.index(f)])
+            boards.append(
+                estimate_board(
+                    group,
+                    base_position + legs.site_position[sites],
+                    base_velocity + legs.site_velocity[sites],
+                    forward=attitude.rotation[:, 0],
+                )
+            )
+        joints = self.joints.hinge_names
+        return EstimatedState(
+            time=time,
+            base_position=base_position,
+            base_quaternion=attitude.quaternion,
+            base_velocity=base_velocity,
+            base_angular_velocity=attitude.angular_velocity,
+            joint_position=MappingProxyType(
+                dict(zip(joints, q[self.joints.hinge_q].tolist(), strict=True))
+            ),
+            joint_velocity=MappingProxyType(
+                dict(zip(joints, v[self.joints.hinge_v].tolist(), strict=True))
+            ),
+            q=q,
+            v=v,
+            foot_names=self.legs.names,
+            contact=stance,
+            foot_position=feet,
+            foot_velocity=base_velocity + legs.foot_velocity,
+            boards=tuple(boards),
+        )

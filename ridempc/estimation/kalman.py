@@ -1,0 +1,88 @@
+"""A linear Kalman filter: predict and update with matrices built elsewhere.
+
+.. math::
+
+    \\text{predict:}\\quad x \\leftarrow F x + b, \\qquad P \\leftarrow F P F^\\top + Q
+
+    \\text{update:}\\quad y = z - H x, \\quad S = H P H^\\top + R, \\quad K = P H^\\top S^{-1},
+    \\quad x \\leftarrow x + K y, \\quad P \\leftarrow P - K H P
+
+(then symmetrised, :math:`P \\leftarrow (P + P^\\top)/2`, against rounding). A
+measurement made in the past can be compared with the state of its time rather than the
+current one: :meth:`LinearKalmanFilter.update` takes the predicted measurement
+:math:`\\hat z` to use instead of :math:`H x`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["LinearKalmanFilter"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class LinearKalmanFilter:
+    """Mean and covariance of a Gaussian state.
+
+    Attributes:
+        x: State mean.
+        P: State covariance.
+    """
+
+    x: Array
+    P: Array
+
+    def predict(self, F: Array, b: Array, Q: Array) -> None:
+        """:math:`x \\leftarrow F x + b`, :math:`P \\leftarrow F P F^\\top + Q`."""
+        self.x = F @ self.x + b
+        self.P = F @ self.P @ F.T + Q
+
+    def update(
+        self,
+        H: Array,
+        z: Array,
+        R: Array,
+        predicted: Array | None = None,
+        gated: NDArray[np.int64] | None = None,
+        gate: float = np.inf,
+    ) -> tuple[Array, int]:
+        """Fuse the measurement :math:`z = H x + n`, :math:`n \\sim N(0, R)`.
+
+        Args:
+            H: Measurement matrix [m x n].
+            z: Measurement [m].
+            R: Measurement covariance [m x m].
+            predicted: :math:`\\hat z` to compare ``z`` with; default :math:`H x`.
+            gated: Groups of rows to test before fusing, shape (groups, rows per group); a
+                group whose normalised innovation :math:`y_g^\\top S_{gg}^{-1} y_g` exceeds
+                ``gate`` is left out (an outlier: a slipping or falsely detected foot).
+            gate: The chi-square threshold of that test.
+
+        Returns:
+            The correction :math:`K y` applied to the state, and how many groups were left out.
+        """
+        y = z - (H @ self.x if predicted is None else predicted)
+        PHt = self.P @ H.T
+        S = H @ PHt + R
+        rejected = 0
+        if gated is not None and gated.size:
+            blocks = S[gated[:, :, None], gated[:, None, :]]
+            innovations = y[gated]
+            whitened = np.linalg.solve(blocks, innovations[..., None])[..., 0]
+            outliers = (innovations * whitened).sum(axis=1) > gate
+            rejected = int(np.count_nonzero(outliers))
+            if rejected:
+                keep = np.ones(y.size, dtype=bool)
+                keep[gated[outliers].ravel()] = False
+                y, PHt, S = y[keep], PHt[:, keep], S[np.ix_(keep, keep)]
+        K = np.linalg.solve(S, PHt.T).T
+        correction = K @ y
+        self.x = self.x + correction
+        P = self.P - K @ PHt.T
+        self.P = 0.5 * (P + P.T)
+        return correction, rejected
