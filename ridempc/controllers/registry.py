@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ridempc.controllers.base import Controller
+from ridempc.controllers.pd import make_pd_baseline
 from ridempc.controllers.stand import StandController
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.robots.robot import Robot
@@ -17,6 +18,7 @@ DEAD_WEIGHT = "dead-weight"  # the controller of a dead weight: none at all
 # name -> factory(robot, board name)
 CONTROLLERS: dict[str, Callable[[Robot, str], Controller]] = {
     "stand": StandController,
+    "pd": make_pd_baseline,
 }
 
 
