@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
 from ridempc.errors import ConfigError
+from ridempc.mjcf import add_imu_sensors
 from ridempc.robots.robot import Robot
 
 __all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
@@ -129,21 +130,6 @@ def _add_world(spec: mujoco.MjSpec, physics_hz: int) -> None:
     )
 
 
-def _add_imu_sensors(spec: mujoco.MjSpec, imu_site: str) -> None:
-    sensors = (
-        ("quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT),
-        ("gyro", mujoco.mjtSensor.mjSENS_GYRO),
-        ("accel", mujoco.mjtSensor.mjSENS_ACCELEROMETER),
-    )
-    for suffix, kind in sensors:
-        spec.add_sensor(
-            name=f"{imu_site}_{suffix}",
-            type=kind,
-            objtype=mujoco.mjtObj.mjOBJ_SITE,
-            objname=imu_site,
-        )
-
-
 def _geom_bottom(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> float:
     """Lowest world z of one geom [m]: exact for spheres, capsules, boxes and ellipsoids,
     the oriented bounding box otherwise."""
@@ -239,7 +225,7 @@ def build_scene(
         spec.delete(key)
     _add_world(spec, physics_hz)
     if robot is not None:
-        _add_imu_sensors(spec, robot.params.imu_site)
+        add_imu_sensors(spec, robot.params.imu_site)
         rider_names = [robot.params.base_body]
     platforms = board.params.platform_sites if board is not None else ()
     if robot is None:

@@ -28,6 +28,7 @@ import numpy as np
 
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.parameters import BoardParameters
+from ridempc.mjcf import add_encoder_sensors, add_imu_sensors
 
 __all__ = ["SIDES", "build_hovershoes", "shoe_names"]
 
@@ -153,26 +154,8 @@ def _add_shoe(spec: mujoco.MjSpec, p: HovershoesParameters, index: int, y: float
         ctrllimited=True,
         ctrlrange=[-p.motor_torque_limit, p.motor_torque_limit],
     )  # a <motor>: unit gain, no bias (MjSpec writes it as the equivalent <general>)
-    site_sensors = (
-        ("quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT),
-        ("gyro", mujoco.mjtSensor.mjSENS_GYRO),
-        ("accel", mujoco.mjtSensor.mjSENS_ACCELEROMETER),
-    )
-    for key, kind in site_sensors:
-        spec.add_sensor(
-            name=names[key], type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=names["imu"]
-        )
-    joint_sensors = (
-        ("wheel_angle", mujoco.mjtSensor.mjSENS_JOINTPOS),
-        ("wheel_speed", mujoco.mjtSensor.mjSENS_JOINTVEL),
-    )
-    for key, kind in joint_sensors:
-        spec.add_sensor(
-            name=names[key],
-            type=kind,
-            objtype=mujoco.mjtObj.mjOBJ_JOINT,
-            objname=names["wheel_joint"],
-        )
+    add_imu_sensors(spec, names["imu"])
+    add_encoder_sensors(spec, names["wheel_joint"], names["wheel_angle"], names["wheel_speed"])
 
 
 def build_hovershoes(params: BoardParameters) -> mujoco.MjSpec:

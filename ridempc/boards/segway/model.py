@@ -25,6 +25,7 @@ import numpy as np
 from ridempc.boards.parameters import BoardParameters
 from ridempc.boards.segway.parameters import SegwayParameters
 from ridempc.errors import ConfigError
+from ridempc.mjcf import add_imu_sensors
 
 __all__ = ["build_segway", "wheel_sides"]
 
@@ -181,17 +182,7 @@ def _add_knee_bar(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: SegwayParamet
 
 
 def _add_imu(spec: mujoco.MjSpec) -> None:
-    for suffix, kind in (
-        ("quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT),
-        ("gyro", mujoco.mjtSensor.mjSENS_GYRO),
-        ("accel", mujoco.mjtSensor.mjSENS_ACCELEROMETER),
-    ):
-        spec.add_sensor(
-            name=f"platform_{suffix}",
-            type=kind,
-            objtype=mujoco.mjtObj.mjOBJ_SITE,
-            objname="platform",
-        )
+    add_imu_sensors(spec, "platform")
 
 
 def _freeze_inertials(spec: mujoco.MjSpec) -> None:

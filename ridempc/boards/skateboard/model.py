@@ -35,6 +35,7 @@ import math
 import mujoco
 
 from ridempc.boards.skateboard.parameters import SkateboardParameters
+from ridempc.mjcf import add_encoder_sensors, add_imu_sensors
 
 __all__ = [
     "DECK",
@@ -170,21 +171,9 @@ def _add_truck(
 
 
 def _add_sensors(spec: mujoco.MjSpec) -> None:
-    site = mujoco.mjtObj.mjOBJ_SITE
-    for name, kind in (
-        ("imu_quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT),
-        ("imu_gyro", mujoco.mjtSensor.mjSENS_GYRO),
-        ("imu_accel", mujoco.mjtSensor.mjSENS_ACCELEROMETER),
-    ):
-        spec.add_sensor(name=name, type=kind, objtype=site, objname=PLATFORM_SITE)
-    joint = mujoco.mjtObj.mjOBJ_JOINT
+    add_imu_sensors(spec, PLATFORM_SITE, prefix="imu")
     for name in (*TRUCKS, *WHEELS[0], *WHEELS[1]):
-        spec.add_sensor(
-            name=f"{name}_pos", type=mujoco.mjtSensor.mjSENS_JOINTPOS, objtype=joint, objname=name
-        )
-        spec.add_sensor(
-            name=f"{name}_vel", type=mujoco.mjtSensor.mjSENS_JOINTVEL, objtype=joint, objname=name
-        )
+        add_encoder_sensors(spec, name, f"{name}_pos", f"{name}_vel")
 
 
 def build_skateboard(params: SkateboardParameters) -> mujoco.MjSpec:
