@@ -11,9 +11,26 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+from numpy.typing import NDArray
+
 from ridempc.errors import RidempcError
 
-__all__ = ["IdentificationFailed", "IdentificationResult"]
+__all__ = ["IdentificationFailed", "IdentificationResult", "nrmse", "r_squared"]
+
+
+def nrmse(measured: NDArray[np.float64], predicted: NDArray[np.float64]) -> float:
+    """RMSE over the measured signal's range [-] (inf for a constant signal)."""
+    span = float(np.ptp(measured))
+    rmse = float(np.sqrt(np.mean((measured - predicted) ** 2)))
+    return rmse / span if span > 0 else float("inf")
+
+
+def r_squared(measured: NDArray[np.float64], predicted: NDArray[np.float64]) -> float:
+    """Coefficient of determination :math:`1 - SS_{res} / SS_{tot}` [-]."""
+    total = float(np.sum((measured - measured.mean()) ** 2))
+    residual = float(np.sum((measured - predicted) ** 2))
+    return 1.0 - residual / total if total > 0 else float("-inf")
 
 
 class IdentificationFailed(RidempcError):

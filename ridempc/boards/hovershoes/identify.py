@@ -43,7 +43,12 @@ from ridempc.boards.hovershoes.parameters import (
     HovershoesReducedParameters,
 )
 from ridempc.boards.hovershoes.reduced import rollout
-from ridempc.boards.identification import IdentificationFailed, IdentificationResult
+from ridempc.boards.identification import (
+    IdentificationFailed,
+    IdentificationResult,
+    nrmse,
+    r_squared,
+)
 from ridempc.robots import load_robot
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.scene import build_scene
@@ -287,16 +292,6 @@ def fit_speed(trials: list[Trial], dt: float) -> float:
     return float(x @ y / (x @ x))
 
 
-def _nrmse(measured: Array, predicted: Array) -> float:
-    span = float(np.ptp(measured))
-    return float(np.sqrt(np.mean((measured - predicted) ** 2)) / span) if span > 0 else np.inf
-
-
-def _r2(measured: Array, predicted: Array) -> float:
-    total = float(np.sum((measured - measured.mean()) ** 2))
-    return 1.0 - float(np.sum((measured - predicted) ** 2)) / total if total > 0 else -np.inf
-
-
 SCORED: dict[str, int] = {"theta": 3, "v": 6, "psi_dot": 5, "psi": 2}
 
 
@@ -314,9 +309,11 @@ def score(params: HovershoesReducedParameters, trials: list[Trial], dt: float) -
         position_span.append(float(np.ptp(trial.state[:, 0])))
     fit: dict[str, float] = {}
     for name in SCORED:
-        nrmse = [_nrmse(m, p) for m, p in zip(measured[name], predicted[name], strict=True)]
-        fit[f"{name}_nrmse"] = float(np.mean(nrmse))
-        fit[f"{name}_r2"] = _r2(np.concatenate(measured[name]), np.concatenate(predicted[name]))
+        errors = [nrmse(m, p) for m, p in zip(measured[name], predicted[name], strict=True)]
+        fit[f"{name}_nrmse"] = float(np.mean(errors))
+        fit[f"{name}_r2"] = r_squared(
+            np.concatenate(measured[name]), np.concatenate(predicted[name])
+        )
     fit["position_nrmse"] = float(
         np.mean(
             [

@@ -28,7 +28,12 @@ from numpy.typing import NDArray
 from pydantic import ValidationError
 
 from ridempc.boards.board import Board
-from ridempc.boards.identification import IdentificationFailed, IdentificationResult
+from ridempc.boards.identification import (
+    IdentificationFailed,
+    IdentificationResult,
+    nrmse,
+    r_squared,
+)
 from ridempc.boards.segway.experiments import Trial, piecewise, random_steps, run_trial, sine
 from ridempc.boards.segway.parameters import SegwayParameters, SegwayReducedParameters
 from ridempc.boards.segway.reduced import simulate_segway
@@ -142,10 +147,8 @@ def score_trial(params: SegwayReducedParameters, trial: Trial) -> dict[str, floa
     predicted = simulate_segway(params, measured[0], controls, trial.dt)
     scores: dict[str, float] = {}
     for name, column in zip(SIGNALS, (3, 5, 6), strict=True):
-        error = predicted[:, column] - measured[:, column]
-        truth = measured[:, column]
-        scores[f"{name}_r2"] = float(1.0 - np.sum(error**2) / np.sum((truth - truth.mean()) ** 2))
-        scores[f"{name}_nrmse"] = float(np.sqrt(np.mean(error**2)) / np.ptp(truth))
+        scores[f"{name}_r2"] = r_squared(measured[:, column], predicted[:, column])
+        scores[f"{name}_nrmse"] = nrmse(measured[:, column], predicted[:, column])
     miss = np.hypot(predicted[:, 0] - measured[:, 0], predicted[:, 1] - measured[:, 1])
     extent = max(np.ptp(measured[:, 0]), np.ptp(measured[:, 1]))
     scores["position_nrmse"] = float(np.sqrt(np.mean(miss**2)) / extent)

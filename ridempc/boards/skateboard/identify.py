@@ -39,7 +39,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
-from ridempc.boards.identification import IdentificationFailed, IdentificationResult
+from ridempc.boards.identification import (
+    IdentificationFailed,
+    IdentificationResult,
+    nrmse,
+    r_squared,
+)
 from ridempc.boards.skateboard.experiments import (
     RollHold,
     SteeringTrial,
@@ -63,9 +68,7 @@ __all__ = [
     "fit_roll",
     "fit_steer_gain",
     "identify",
-    "nrmse",
     "predict_dubins",
-    "r_squared",
     "roll_regression",
 ]
 
@@ -95,18 +98,6 @@ STEERING_TRIALS: tuple[tuple[SteeringTrial, bool], ...] = (
     (SteeringTrial("carve-held-out", 1.0, RollHold(1.0, 0.06, 0.06, 2.0), TRIAL_DURATION), True),
     (SteeringTrial("turn-held-out", 1.5, RollHold(1.0, -0.08), TRIAL_DURATION), True),
 )
-
-
-def nrmse(predicted: Array, measured: Array) -> float:
-    """RMSE over the measured signal's range [-]."""
-    span = float(np.ptp(measured))
-    return float(np.sqrt(np.mean((predicted - measured) ** 2)) / max(span, 1e-12))
-
-
-def r_squared(predicted: Array, measured: Array) -> float:
-    """Coefficient of determination [-]."""
-    residual = float(np.sum((measured - predicted) ** 2))
-    return 1.0 - residual / max(float(np.sum((measured - measured.mean()) ** 2)), 1e-12)
 
 
 def _paper_torque(record: TrialRecord) -> Array:
@@ -174,7 +165,7 @@ def fit_roll(
         raise IdentificationFailed(
             f"non-physical roll estimate I = {inertia:.3g}, K = {stiffness:.3g}, B = {damping:.3g}"
         )
-    return (inertia, stiffness, damping), r_squared(a @ estimate, b)
+    return (inertia, stiffness, damping), r_squared(b, a @ estimate)
 
 
 def predict_roll(
@@ -216,7 +207,7 @@ def _score_roll(
 ) -> tuple[float, float]:
     predicted = np.concatenate([predict_roll(r, torque_of, model) for r in records])
     measured = np.concatenate([r.roll for r in records])
-    return nrmse(predicted, measured), r_squared(predicted, measured)
+    return nrmse(measured, predicted), r_squared(measured, predicted)
 
 
 def _score_steering(records: Sequence[TrialRecord], gain: float) -> dict[str, float]:
@@ -225,14 +216,14 @@ def _score_steering(records: Sequence[TrialRecord], gain: float) -> dict[str, fl
     heading_errors, position_errors = [], []
     for record in records:
         heading, position = predict_dubins(record, gain)
-        heading_errors.append(nrmse(heading, record.heading))
+        heading_errors.append(nrmse(record.heading, heading))
         travelled = float(np.sum(np.linalg.norm(np.diff(record.position, axis=0), axis=1)))
         position_errors.append(
             float(np.linalg.norm(position[-1] - record.position[-1])) / travelled
         )
     return {
-        "yaw_rate_nrmse": nrmse(yaw_pred, yaw_meas),
-        "yaw_rate_r2": r_squared(yaw_pred, yaw_meas),
+        "yaw_rate_nrmse": nrmse(yaw_meas, yaw_pred),
+        "yaw_rate_r2": r_squared(yaw_meas, yaw_pred),
         "heading_nrmse": float(np.mean(heading_errors)),
         "position_error_per_m": float(np.mean(position_errors)),
     }
