@@ -53,6 +53,20 @@ def _parser() -> argparse.ArgumentParser:
     )
     identify.add_argument("--board", required=True, help="board name")
     identify.add_argument("--json", type=Path, default=None, help="also write the result here")
+
+    library = commands.add_parser("library", help="motion libraries (trajectory optimisation)")
+    library_commands = library.add_subparsers(dest="library_command", required=True)
+    build = library_commands.add_parser("build", help="optimise and store a pair's trajectories")
+    show = library_commands.add_parser("show", help="print a library's table, plot an entry")
+    for sub in (build, show):
+        sub.add_argument("--robot", required=True, help="robot name")
+        sub.add_argument("--board", required=True, help="board name")
+    build.add_argument("--targets", default=None, help="comma-separated targets, e.g. 0.3,0.5")
+    build.add_argument("--jobs", type=int, default=1, help="worker processes (default: 1)")
+    build.add_argument("--out", type=Path, default=None, help="library folder")
+    show.add_argument("--dir", type=Path, default=None, help="library folder")
+    show.add_argument("--entry", default=None, help="entry name or target, e.g. 0.5")
+    show.add_argument("--plot", type=Path, default=None, help="write a PNG of the entry")
     return parser
 
 
@@ -70,6 +84,14 @@ def _identify(args: argparse.Namespace) -> int:
     if args.json is not None:
         atomic_write_json(args.json, dataclasses.asdict(result))
     return 0
+
+
+def _library(args: argparse.Namespace) -> int:
+    from ridempc.library.cli import library_build, library_show
+
+    if args.library_command == "build":
+        return library_build(args.robot, args.board, args.targets, args.jobs, args.out)
+    return library_show(args.robot, args.board, args.dir, args.entry, args.plot)
 
 
 def _list() -> int:
@@ -146,6 +168,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _list()
         if args.command == "board":
             return _identify(args)
+        if args.command == "library":
+            return _library(args)
         return _sim(args)
     except (UnknownNameError, ConfigError) as exc:
         print(f"ridempc: error: {exc}", file=sys.stderr)

@@ -1,0 +1,173 @@
+"""CyberDog2 on the skateboard: acceleration trajectories to target speeds (skateboard paper).
+
+Each target speed gives one entry, ``accelerate-<v>``: from rest in the riding keyframe to
+the board at :math:`v` with all four feet back on the deck (:mod:`.skate_problem`). Entries
+are warm-started from the nearest solved one by mapping its phases onto the new schedule.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from functools import lru_cache
+from typing import Any
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.boards import load_board
+from ridempc.errors import ConfigError
+from ridempc.robots import load_robot
+from ridempc.trajopt.pairs import EntrySpec, Guess, Neighbour, Pair
+from ridempc.trajopt.problem import TrajectoryProblem
+from ridempc.trajopt.rigid_body import RigidBodyRobot, build_rigid_body_robot
+from ridempc.trajopt.skate_problem import (
+    SkateOptions,
+    build_skate_problem,
+    skate_guess,
+    skate_rates,
+    speed_bound,
+)
+from ridempc.trajopt.skateboard import BOARD_STATE, SkateboardModel, skateboard_model
+
+__all__ = ["PAIR", "skate_models", "skate_options"]
+
+Array = NDArray[np.float64]
+ROBOT, BOARD = "cyberdog2", "skateboard"
+
+
+@lru_cache(maxsize=1)
+def skate_models() -> tuple[RigidBodyRobot, SkateboardModel]:
+    """The SRBKM CyberDog2 at its ``skateboard`` stance and the skateboard (built once)."""
+    robot = load_robot(ROBOT)
+    keyframe = robot.params.stance_keyframes.get(BOARD, robot.params.stand_keyframe)
+    board = load_board(BOARD)
+    if board is None:
+        raise ConfigError(f"board '{BOARD}' is missing")
+    return build_rigid_body_robot(robot, keyframe), skateboard_model(board)
+
+
+@lru_cache(maxsize=8)
+def _speed_bound(options: SkateOptions) -> float:
+    return speed_bound(skate_models()[0], options)
+
+
+def skate_options(overrides: dict[str, Any]) -> SkateOptions:
+    """:class:`SkateOptions` with ``overrides``; an unknown field is a ConfigError."""
+    fields = {f.name for f in dataclasses.fields(SkateOptions)}
+    unknown = sorted(set(overrides) - fields)
+    if unknown:
+        raise ConfigError(
+            f"unknown skateboard option '{unknown[0]}' (valid: {', '.join(sorted(fields))})"
+        )
+    return dataclasses.replace(SkateOptions(), **overrides)
+
+
+def _entries(targets: Sequence[float]) -> list[EntrySpec]:
+    return [EntrySpec("accelerate", float(t)) for t in targets]
+
+
+def _check(spec: EntrySpec) -> None:
+    if spec.kind != "accelerate":
+        raise ConfigError(f"{ROBOT}-{BOARD} has no '{spec.kind}' trajectories (valid: accelerate)")
+    options = skate_options(spec.options)
+    bound = _speed_bound(options)
+    if not 0.0 < spec.target <= bound:
+        raise ConfigError(
+            f"target {spec.target:g} m/s is unreachable for {ROBOT} on the {BOARD}: no push "
+            f"can help beyond {bound:.1f} m/s (the pushing foot, still on the ground for at "
+            f"least {options.min_push:g} s, would have to sweep farther or faster than its "
+            "leg allows); targets must be in (0, that]"
+        )
+
+
+def _build(spec: EntrySpec) -> TrajectoryProblem:
+    _check(spec)
+    robot, board = skate_models()
+    return build_skate_problem(robot, board, spec.target, skate_options(spec.options), spec.name)
+
+
+def _phase_map(new: list[str], old: list[str]) -> list[int]:
+    """For each phase of the new schedule, the phase of the old one it resembles: the same
+    index from the start, or from the end for the closing phases, or the old schedule's last
+    phase of the same mode for the extra strides of a longer schedule."""
+    mapping = []
+    for j, mode in enumerate(new):
+        from_end = len(new) - j
+        if j < len(old) - 2 and old[j] == mode:
+            mapping.append(j)
+        elif from_end <= 2 and old[len(old) - from_end] == mode:
+            mapping.append(len(old) - from_end)
+        else:
+            same = [i for i, m in enumerate(old[:-2]) if m == mode]
+            mapping.append(same[-1] if same else min(j, len(old) - 1))
+    return mapping
+
+
+def _warm(problem: TrajectoryProblem, neighbour: Neighbour) -> Guess:
+    """Map the neighbour's phases onto this problem's schedule, phase by phase in normalised
+    time, then re-integrate the horizontal positions from the mapped velocities."""
+    new = problem.metadata["phases"]
+    old = neighbour.metadata["phases"]
+    mapping = _phase_map([p["mode"] for p in new], [p["mode"] for p in old])
+    old_starts = np.concatenate([[0.0], np.cumsum([p["duration"] for p in old])])
+    dt = problem.dt
+    sources = []
+    for j, p in enumerate(new):
+        steps = round(p["duration"] / dt)
+        i = mapping[j]
+        fractions = np.arange(steps) / steps
+        sources.append(old_starts[i] + fractions * old[i]["duration"])
+    source = np.concatenate([*sources, [neighbour.times[-1]]])
+
+    def sample(values: Array, times: Array) -> Array:
+        return np.column_stack(
+            [np.interp(source, times, values[:, c]) for c in range(values.shape[1])]
+        )
+
+    states = sample(neighbour.states, neighbour.times)
+    inputs = sample(neighbour.inputs, neighbour.times[:-1])[:-1]
+    nr = problem.nx - len(BOARD_STATE)
+    relative = states[:, 0:2] - states[:, nr : nr + 2]
+    heading, speed = states[:, nr + 2], states[:, nr + 3]
+    velocity = np.column_stack([speed * np.cos(heading), speed * np.sin(heading)])
+    board_xy = np.vstack([[0.0, 0.0], np.cumsum(0.5 * (velocity[1:] + velocity[:-1]) * dt, 0)])
+    states[:, nr : nr + 2] = board_xy
+    states[:, 0:2] = board_xy + relative
+    low = problem.lbw[: problem.nx] * problem.state_scale
+    states[0] = low  # node 0 is fixed by its bounds: the keyframe at rest
+    # Inputs of phases where a foot is now swinging are clipped to zero by the bounds.
+    return Guess(states, inputs, None)
+
+
+def _guess(problem: TrajectoryProblem, neighbour: Neighbour | None) -> Guess:
+    robot, board = skate_models()
+    if neighbour is not None and neighbour.metadata.get("pair") == problem.metadata["pair"]:
+        return _warm(problem, neighbour)
+    states, inputs = skate_guess(robot, board, problem)
+    return Guess(states, inputs, None)
+
+
+def _rates(metadata: dict[str, Any]) -> ca.Function:
+    robot, board = skate_models()
+    return skate_rates(robot, board)
+
+
+def _board_states() -> tuple[int, ...]:
+    robot, _ = skate_models()
+    nr = 12 + robot.n_joints
+    return tuple(range(nr, nr + len(BOARD_STATE)))
+
+
+PAIR = Pair(
+    robot=ROBOT,
+    board=BOARD,
+    default_targets=(0.3, 0.5, 0.7, 1.0),
+    entries=_entries,
+    check=_check,
+    build=_build,
+    guess=_guess,
+    rates=_rates,
+    board_states=_board_states,
+)
