@@ -19,6 +19,7 @@ __all__ = ["PD_BASELINES", "make_pd_baseline"]
 # (robot kind, board kind) -> "module:Class"
 PD_BASELINES: dict[tuple[str, str], str] = {
     ("biped", "none"): "ridempc.baselines.cassie_standing:CassieStanding",
+    ("biped", "segway"): "ridempc.baselines.cassie_segway:CassieSegway",
 }
 
 
