@@ -20,6 +20,8 @@ __all__ = ["PD_BASELINES", "make_pd_baseline"]
 PD_BASELINES: dict[tuple[str, str], str] = {
     ("biped", "none"): "ridempc.baselines.cassie_standing:CassieStanding",
     ("biped", "segway"): "ridempc.baselines.cassie_segway:CassieSegway",
+    ("quadruped", "none"): "ridempc.baselines.quadruped_skateboard:QuadrupedSkateboardPD",
+    ("quadruped", "skateboard"): "ridempc.baselines.quadruped_skateboard:QuadrupedSkateboardPD",
 }
 
 
