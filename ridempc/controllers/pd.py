@@ -19,6 +19,7 @@ __all__ = ["PD_BASELINES", "make_pd_baseline"]
 # (robot kind, board kind) -> "module:Class"
 PD_BASELINES: dict[tuple[str, str], str] = {
     ("biped", "none"): "ridempc.baselines.cassie_standing:CassieStanding",
+    ("biped", "hovershoes"): "ridempc.baselines.cassie_hovershoes:CassieHovershoes",
     ("biped", "segway"): "ridempc.baselines.cassie_segway:CassieSegway",
     ("quadruped", "none"): "ridempc.baselines.quadruped_skateboard:QuadrupedSkateboardPD",
     ("quadruped", "skateboard"): "ridempc.baselines.quadruped_skateboard:QuadrupedSkateboardPD",
