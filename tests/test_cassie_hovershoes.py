@@ -170,16 +170,16 @@ def test_stands_on_the_shoes_without_rolling_away(cassie) -> None:
     )
     assert result.status == "ok", result.fall_reason or result.error
     log = result.log
-    settled = log["time"] >= 2.0
-    assert np.max(np.abs(log["forward_velocity"][settled])) < 0.1
-    assert np.max(np.abs(_shoe_spacing(log) - _shoe_spacing(log)[0])) < 0.01
+    settled = log["time"] >= 2.0  # measured: |v| < 0.02 m/s, spacing within 0.4 mm
+    assert np.max(np.abs(log["forward_velocity"][settled])) < 0.05
+    assert np.max(np.abs(_shoe_spacing(log) - _shoe_spacing(log)[0])) < 0.005
     estimate = controller.estimate()
     assert estimate is not None and len(estimate.boards) == 2
 
 
 def test_rides_a_velocity_step(cassie) -> None:
     """0 -> 0.5 m/s (eq. 17): within 0.1 m/s of the command 2.5 s after the step (measured:
-    about 0.03 m/s below it), the shoes side by side."""
+    at most 0.035 m/s off), the shoes side by side (measured: 0.4 mm of stagger)."""
     scenario = Scenario(
         name="step",
         duration=5.0,
@@ -191,4 +191,4 @@ def test_rides_a_velocity_step(cassie) -> None:
     late = log["time"] >= 4.0
     assert np.max(np.abs(log["forward_velocity"][late] - 0.5)) < 0.1
     stagger = log["board_position"][:, 0, 0] - log["board_position"][:, 1, 0]
-    assert np.max(np.abs(stagger)) < 0.02
+    assert np.max(np.abs(stagger)) < 0.005

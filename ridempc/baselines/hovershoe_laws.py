@@ -162,8 +162,8 @@ def turning(
     motors, against the tyres' scrub (the paper's sign: the torque on the legs), and raises
     the left (inner) toe, lowering the right (outer) one, so the outer shoe runs faster;
     the CoM shifts into the turn by the lean that balances the centripetal acceleration
-    :math:`\\dot\\psi v` at the CoM height :math:`L` over the platforms. The torques are
-    clipped to ``max_toe_torque`` and the shift to ``max_com_y``.
+    :math:`\\dot\\psi v` at the CoM height :math:`L` over the platforms. The toe torque
+    is clipped to ``max_toe_torque`` and the shift to ``max_com_y``.
 
     Args:
         gains: Turning gains.
