@@ -48,3 +48,19 @@ class RecordingController(StandController):
 
 def scenario(duration: float, **fields) -> Scenario:
     return Scenario(name="test", duration=duration, **fields)
+
+
+def assert_gain_edit_refused(default_file, tmp_path, old: str, new: str, field: str, build) -> None:
+    """Write ``default_file`` with ``old`` replaced by ``new``; ``build(path)`` must refuse it
+    with a ConfigError naming ``field`` and the file."""
+    import pytest
+
+    from ridempc.errors import ConfigError
+
+    text = default_file.read_text()
+    assert old in text
+    path = tmp_path / "gains.toml"
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ConfigError, match=field.replace(".", r"\.")) as info:
+        build(path)
+    assert str(path) in str(info.value)

@@ -9,13 +9,12 @@ the field.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from ridempc.errors import ConfigError
+from ridempc.tomlfile import load_checked
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -139,15 +138,4 @@ def load_standing_gains(path: Path | str = DEFAULT_GAINS_FILE) -> CassieStanding
         ConfigError: The file is missing, is not TOML, or a field is missing or wrong;
             the message names the file and the field.
     """
-    path = Path(path)
-    try:
-        with open(path, "rb") as stream:
-            raw = tomllib.load(stream)
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: standing gain file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
-    try:
-        return CassieStandingGains.model_validate(raw)
-    except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+    return load_checked(Path(path), CassieStandingGains, "standing gain file")

@@ -11,14 +11,13 @@ the file and the field.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
 from ridempc.baselines.cassie_standing_gains import CassieStandingGains
-from ridempc.errors import ConfigError
+from ridempc.tomlfile import load_checked
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -133,15 +132,4 @@ def load_hovershoes_gains(path: Path | str = DEFAULT_GAINS_FILE) -> CassieHovers
         ConfigError: The file is missing, is not TOML, or a field is missing or wrong;
             the message names the file and the field.
     """
-    path = Path(path)
-    try:
-        with open(path, "rb") as stream:
-            raw = tomllib.load(stream)
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: hovershoe gain file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
-    try:
-        return CassieHovershoesGains.model_validate(raw)
-    except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+    return load_checked(Path(path), CassieHovershoesGains, "hovershoe gain file")
