@@ -193,7 +193,11 @@ def test_identified_model_predicts_held_out_trials(board, params) -> None:
     assert result.fit["theta_nrmse"] < 0.05
     assert result.fit["v_nrmse"] < 0.15
     assert result.fit["psi_dot_nrmse"] < 0.1
-    assert result.fit["theta_r2"] > 0.95 and result.fit["psi_dot_r2"] > 0.95
+    assert result.fit["theta_r2"] > 0.95
+    # With the scene's no-slip friction pass the tyre's rim friction is Coulomb (it sticks,
+    # then slides), which the paper's linear eq. (5) fits only to r^2 of about 0.87-0.90
+    # (0.95 with the soft contact's viscous creep before the pass was added).
+    assert result.fit["psi_dot_r2"] > 0.85
     # It agrees with the parameters identified in full and recorded in board.toml.
     assert params.reduced is not None
     recorded = params.reduced.model_dump()

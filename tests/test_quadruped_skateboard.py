@@ -164,16 +164,11 @@ def test_it_rides_only_a_skateboard_or_flat_ground(dog) -> None:
 # ---------------------------------------------------------------- rides
 
 
-def _ride(dog, board: str, scenario_name: str, duration: float, no_slip: bool = False):
+def _ride(dog, board: str, scenario_name: str, duration: float):
     scenario = resolve_scenario(scenario_name, board).with_duration(duration)
     scene = build_scene(
         dog, DEFAULT_PHYSICS_HZ, board=load_board(board), foot_offset=scenario.foot_offset
     )
-    if no_slip:
-        # MuJoCo's soft friction lets a loaded foot creep down the rolled deck at about
-        # 0.35 m/s per rad of roll with the scene's default contact; the roll-tracking ride is
-        # checked with the no-slip pass that stops it (see the controller's report).
-        scene.model.opt.noslip_iterations = 10
     controller = QuadrupedSkateboardPD(dog, board)
     result = Simulation(scene, controller, scenario).run()
     return result, run_metrics(result, scenario, dog)
@@ -194,7 +189,7 @@ def test_stands_on_the_skateboard(dog) -> None:
 
 
 def test_tracks_the_deck_roll_reference(dog) -> None:
-    result, metrics = _ride(dog, "skateboard", "roll-tracking", 10.0, no_slip=True)
+    result, metrics = _ride(dog, "skateboard", "roll-tracking", 10.0)
     assert result.status == "ok", result.fall_reason or result.error
     # measured 0.016 rad over 2-10 s (0.012 over the full 32 s ride): the start of the wave
     # rings the deck for a second; the bound leaves room for other platforms' arithmetic

@@ -76,7 +76,7 @@ from ridempc.baselines.hovershoe_laws import (
     toe_difference_torque,
     turning,
 )
-from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.estimation import EstimatedState
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
@@ -111,8 +111,7 @@ class CassieHovershoes(CassieStanding):
         self.rider_gains = (
             gains if isinstance(gains, CassieHovershoesGains) else load_hovershoes_gains(gains)
         )
-        super().__init__(robot, board, self.rider_gains.standing)
-        self.estimator = StateEstimator(robot, platforms=PLATFORM_FEET)
+        super().__init__(robot, board, self.rider_gains.standing, platforms=PLATFORM_FEET)
         g = self.rider_gains
         self._speed_filter = LowPassFilter(g.velocity.filter_hz)
         self._yaw_rate_filter = LowPassFilter(g.turning.filter_hz)
@@ -129,7 +128,6 @@ class CassieHovershoes(CassieStanding):
     def reset(self, sensors: SensorPacket) -> None:
         """Standing posture, estimator and the nominal half-spacing from the first packet."""
         super().reset(sensors)
-        self.estimator.reset(sensors)
         feet = self._feet(self.kinematic_state(sensors))
         self._half_spacing = 0.5 * float(feet[0, 1] - feet[1, 1])
         self._yaw_integral = 0.0
@@ -141,9 +139,6 @@ class CassieHovershoes(CassieStanding):
             self._feet_y_filter,
         ):
             low_pass.reset()
-
-    def estimate(self) -> EstimatedState | None:
-        return self.estimator.state
 
     @staticmethod
     def _feet(state: KinematicState) -> Array:

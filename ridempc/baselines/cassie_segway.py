@@ -13,12 +13,12 @@ outer loops set them from the commanded speed and yaw rate:
 1. **Crouched posture** (``standing.posture``). Standing tall, Cassie's shins cross the knee
    pad's height (0.45-0.55 m over the platform) 0.13-0.24 m behind the pad: they cannot
    reach it. Crouched to a virtual leg of 0.62 m, the upper shins, just below the knees, are
-   at the pad's height and beside it. From the ``ride_segway`` stance (feet 0.26 m apart) the
-   upper shins (radius 0.04 m) would overlap the 0.20 m pad by 1 cm a side and clamp it with
-   some 70 N, and the friction of that clamp holds the knees back when the CoM should lean;
-   an outward hip roll of 0.06 rad spreads the feet to about 0.34 m (the paper's "roughly
-   0.3 m apart"; they slide out while crouching, pushed by the pad and the hip roll) and
-   leaves each shin about 4 mm off the pad. The hip roll is turned first, over
+   at the pad's height and beside it. The shins (radius 0.04 m) must straddle the 0.20 m
+   pad: from a stance 0.26 m wide they would clamp it with some 70 N while crouching, and a
+   clamp's friction drags the pad and steers the Segway. The ``ride_segway`` stance puts the
+   feet 0.335 m apart (hip roll 0.04 rad outward; the paper's "roughly 0.3 m apart"), and
+   the crouched posture's hip roll of 0.06 rad leaves each shin a few millimetres off the
+   pad, so a lean of a few millimetres pushes it. The hip roll is turned first, over
    ``mount.spread_time``, then the legs shorten from their starting length at
    ``legs.max_speed`` (the standing controller would jump to both at the first tick).
 2. **Feet's feedback turned down** (``standing.com_x``, ``standing.joints.toe``): half the
@@ -70,10 +70,9 @@ from ridempc.baselines.cassie_segway_gains import (
 )
 from ridempc.baselines.cassie_standing import CassieStanding, StandingTargets
 from ridempc.baselines.filters import LowPassFilter
-from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.estimation import EstimatedState
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
-from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 
 __all__ = ["CassieSegway", "ShiftLoop"]
@@ -157,10 +156,8 @@ class CassieSegway(CassieStanding):
         segway = gains if isinstance(gains, CassieSegwayGains) else load_segway_gains(gains)
         super().__init__(robot, board, segway.standing)
         self.segway_gains = segway
-        self.estimator = StateEstimator(robot, platforms=(robot.params.foot_bodies,))
         self.velocity_loop = ShiftLoop(segway.velocity)
         self.turning_loop = ShiftLoop(segway.turning)
-        self._estimate: EstimatedState | None = None
         self._start: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def reset(self, sensors: SensorPacket) -> None:
@@ -171,12 +168,8 @@ class CassieSegway(CassieStanding):
             for side in SIDES
         ]
         self._start = (state.time, float(np.mean(state.leg_length)), float(np.mean(rolls)))
-        self.estimator.reset(sensors)
         self.velocity_loop.reset()
         self.turning_loop.reset()
-
-    def estimate(self) -> EstimatedState | None:
-        return self._estimate
 
     def forward_speed(self, estimate: EstimatedState) -> float:
         """The platform's speed along the rider's heading, from the feet [m/s]."""
@@ -210,7 +203,7 @@ class CassieSegway(CassieStanding):
         errors."""
         leg_length, hip_roll = self.posture(state.time)
         nominal = replace(self.nominal, leg_length=leg_length, hip_roll=hip_roll)
-        estimate = self._estimate
+        estimate = self.estimator.state
         if estimate is None:
             return nominal
         shift_x = self.velocity_loop(state.time, command.velocity, self.forward_speed(estimate))
@@ -222,9 +215,3 @@ class CassieSegway(CassieStanding):
         )
         return replace(nominal, com_x=nominal.com_x + shift_x, com_y=nominal.com_y + shift_y)
 
-    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
-        if self._nominal is None:
-            self.reset(sensors)
-        self._estimate = self.estimator.update(sensors)
-        state = self.kinematic_state(sensors)
-        return self.motor_command(state, self.targets(state, command))

@@ -76,6 +76,7 @@ from ridempc.baselines.cassie_standing_gains import (
 from ridempc.baselines.cassie_statics import FootLoad, StandingStatics
 from ridempc.baselines.filters import LowPassFilter
 from ridempc.controllers.base import Controller
+from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
@@ -120,6 +121,8 @@ class CassieStanding(Controller):
         robot: Cassie.
         board: The board's name (``none`` on flat ground); standing ignores it.
         gains: Checked gains, or the gain file to read (``cassie_standing.toml``).
+        platforms: The feet on each board platform, for the state estimator (default: both
+            feet on one platform on a board, none on flat ground).
 
     Raises:
         ConfigError: The gain file is malformed, or the robot lacks Cassie's joints.
@@ -130,8 +133,14 @@ class CassieStanding(Controller):
         robot: Robot,
         board: str = "none",
         gains: CassieStandingGains | Path | str = DEFAULT_GAINS_FILE,
+        platforms: tuple[tuple[str, ...], ...] | None = None,
     ) -> None:
         super().__init__(robot, board)
+        if platforms is None:
+            platforms = (robot.params.foot_bodies,) if board != "none" else ()
+        # Runs on every tick, so every ride reports the estimator's error; the riders on a
+        # board read its state, standing reads only the IMU and the encoders.
+        self.estimator = StateEstimator(robot, platforms=platforms)
         self.gains = gains if isinstance(gains, CassieStandingGains) else load_standing_gains(gains)
         self.rate_hz = self.gains.rate_hz
         self.kinematics = CassieKinematics(robot)
@@ -197,6 +206,7 @@ class CassieStanding(Controller):
         self._com_filter.reset()
         self._roll_filter.reset()
         self._leg_length = None
+        self.estimator.reset(sensors)
 
     @property
     def nominal(self) -> StandingTargets:
@@ -303,8 +313,13 @@ class CassieStanding(Controller):
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         if self._nominal is None:
             self.reset(sensors)
+        else:
+            self.estimator.update(sensors)
         state = self.kinematic_state(sensors)
         return self.motor_command(state, self.targets(state, command))
 
     def diagnostics(self) -> dict[str, float]:
         return dict(self._diagnostics)
+
+    def estimate(self) -> EstimatedState | None:
+        return self.estimator.state

@@ -27,6 +27,10 @@ FLOOR_FRICTION: tuple[float, float, float] = (1.0, 0.005, 0.0001)  # slide, spin
 # not centimetres; the time constant stays above two physics steps (1.3 ms at 1500 Hz).
 GROUND_SOLREF: tuple[float, float] = (0.005, 1.0)  # time constant [s], damping ratio
 GROUND_SOLIMP: tuple[float, ...] = (0.95, 0.99, 0.001, 0.5, 2.0)  # impedance, width [m], shape
+# MuJoCo's soft contacts let a loaded foot creep down a tilted or turning platform (the
+# constraint force only builds up with slip velocity). Noslip iterations project the
+# friction forces back inside the cone after the main solve, so a standing foot holds.
+NOSLIP_ITERATIONS: int = 10
 
 
 BOARD_PREFIX = "board/"
@@ -90,6 +94,7 @@ class Scene:
 def _add_world(spec: mujoco.MjSpec, physics_hz: int) -> None:
     spec.option.timestep = 1.0 / physics_hz
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.noslip_iterations = NOSLIP_ITERATIONS
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 720
     spec.add_texture(

@@ -394,7 +394,7 @@ def identify(
             f"random pitch doublets up to {PITCH_TORQUE} N m and yaw doublets up to "
             f"{YAW_TORQUE} N m on each box, {TRIAL_DURATION} s per trial, logged at "
             f"{LOG_HZ:g} Hz; valid below the speed limit ({params.speed_limit} m/s) and the "
-            "linear yaw creep of the tyre (up to about 4 N m per shoe with this load; it breaks "
+            "tyre's yaw grip (it sticks up to about 4 N m per shoe with this load; it breaks "
             "loose at about 7 N m)"
         ),
         extra={
