@@ -36,6 +36,13 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--out", type=Path, required=True, help="output folder")
     sim.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
     sim.add_argument("--video", action="store_true", help="render video.mp4 offscreen")
+    sim.add_argument(
+        "--snapshots",
+        type=int,
+        default=0,
+        metavar="N",
+        help="write snapshots.png, N frames evenly spaced over the ride (default: none)",
+    )
     sim.add_argument("--no-plots", action="store_true", help="do not write plots.png")
     sim.add_argument("--viewer", action="store_true", help="open MuJoCo's interactive viewer")
     sim.add_argument(
@@ -123,6 +130,8 @@ def _sim(args: argparse.Namespace) -> int:
 
     if args.viewer and args.video:
         raise ConfigError("--viewer and --video cannot be used together")
+    if args.snapshots < 0:
+        raise ConfigError(f"--snapshots {args.snapshots}: must be 0 (none) or more")
     if args.viewer and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         print(
             "ridempc: --viewer needs a display and none is available (DISPLAY is not set); "
@@ -139,6 +148,7 @@ def _sim(args: argparse.Namespace) -> int:
         duration=args.duration,
         seed=args.seed,
         video=args.video,
+        snapshots=args.snapshots,
         plots=not args.no_plots,
         viewer=args.viewer,
         ground_truth=args.ground_truth,

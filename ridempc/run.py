@@ -1,9 +1,9 @@
 """One ride, start to finish: resolve names, build the scene, simulate, write the results.
 
-The output folder receives ``log.npz`` (time series), optionally ``video.mp4`` and
-``plots.png``, and last of all ``summary.json``. Every file is written atomically, and a
-stale ``summary.json`` from an earlier run is removed before the new run starts, so an
-interrupted run never leaves a summary that looks complete.
+The output folder receives ``log.npz`` (time series), optionally ``video.mp4``,
+``snapshots.png`` (a strip of still frames) and ``plots.png``, and last of all
+``summary.json``. Every file is written atomically, and a stale ``summary.json`` from an
+earlier run is removed before the new run starts, so an interrupted run never leaves a summary that looks complete.
 """
 
 from __future__ import annotations
@@ -41,6 +41,7 @@ class RideRequest:
         duration: Override of the scenario's duration [s], or None.
         seed: Seed of all random draws.
         video: Render ``video.mp4``.
+        snapshots: Number of still frames for ``snapshots.png`` (0: none).
         plots: Write ``plots.png``.
         viewer: Show the interactive viewer (needs a display).
         ground_truth: Give the controller ground truth (debugging only; flagged in the summary).
@@ -55,6 +56,7 @@ class RideRequest:
     duration: float | None = None
     seed: int = 0
     video: bool = False
+    snapshots: int = 0
     plots: bool = True
     viewer: bool = False
     ground_truth: bool = False
@@ -102,29 +104,49 @@ def ride(request: RideRequest) -> dict[str, Any]:
     )
     video = None
     viewer = None
-    on_frame: Any = None
+    strip = None
+    frame_callbacks: list[Any] = []
+    height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
     if request.video:
         from ridempc.sim.video import VideoRecorder
 
-        height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
         video = VideoRecorder(
             scene.model,
             out / "video.mp4",
             track_body=scene.base_body,
             distance=max(1.2, 3.0 * height),
         )
-        on_frame = video
+        frame_callbacks.append(video)
     elif request.viewer:
         from ridempc.sim.viewer import LiveViewer
 
-        viewer = on_frame = LiveViewer(scene.model, scene.data)
+        viewer = LiveViewer(scene.model, scene.data)
+        frame_callbacks.append(viewer)
+    (out / "snapshots.png").unlink(missing_ok=True)
+    if request.snapshots > 0:
+        from ridempc.sim.snapshots import SnapshotStrip
+
+        strip = SnapshotStrip(
+            scene.model,
+            out / "snapshots.png",
+            track_body=scene.base_body,
+            duration=scenario.duration,
+            count=request.snapshots,
+            distance=max(1.2, 3.0 * height),
+        )
+        frame_callbacks.append(strip)
+
+    def on_frame(model: Any, data: Any) -> None:
+        for callback in frame_callbacks:
+            callback(model, data)
+
     simulation = Simulation(
         scene,
         controller,
         scenario,
         seed=request.seed,
         ground_truth=request.ground_truth,
-        on_frame=on_frame,
+        on_frame=on_frame if frame_callbacks else None,
     )
     try:
         result = simulation.run()
@@ -133,11 +155,15 @@ def ride(request: RideRequest) -> dict[str, Any]:
             video.close(keep=True)
         if viewer is not None:
             viewer.close()
+        if strip is not None:
+            strip.close(scene.data)
 
     atomic_write_npz(out / "log.npz", result.log)
     files = ["log.npz"]
     if video is not None and video.frames:
         files.append("video.mp4")
+    if strip is not None and strip.frames:
+        files.append("snapshots.png")
     if request.plots and result.log:
         from ridempc.sim.plots import plot_run
 

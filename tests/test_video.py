@@ -1,4 +1,4 @@
-"""``--video`` renders offscreen at 30 frames per simulated second."""
+"""``--video`` renders offscreen at 30 frames per simulated second; ``--snapshots`` a strip."""
 
 from __future__ import annotations
 
@@ -22,3 +22,24 @@ def test_video_is_rendered(tmp_path, capsys) -> None:
     frames = [np.frombuffer(f, np.uint8).reshape(height, width, 3) for f in reader]
     assert len(frames) == 16  # t = 0, 1/30, ..., 0.5 s
     assert np.std(frames[-1]) > 5.0  # a picture, not a blank frame
+
+
+def test_snapshot_strip_is_written(tmp_path) -> None:
+    import imageio.v2 as imageio
+
+    out = tmp_path / "snap"
+    args = ["sim", "--robot", "cyberdog2", "--duration", "0.5", "--snapshots", "3"]
+    assert main([*args, "--no-plots", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert "snapshots.png" in summary["files"]
+    image = imageio.imread(out / "snapshots.png")
+    assert image.shape[1] > 2 * image.shape[0]  # three frames side by side
+    assert np.std(image[..., :3]) > 5.0
+    assert not list(out.glob(".*.tmp.png"))
+
+
+def test_negative_snapshot_count_is_refused(tmp_path, capsys) -> None:
+    out = tmp_path / "bad"
+    assert main(["sim", "--snapshots", "-1", "--out", str(out)]) == 2
+    assert "--snapshots -1" in capsys.readouterr().err
+    assert not out.exists()
