@@ -3,7 +3,8 @@
 The output folder receives ``log.npz`` (time series), optionally ``video.mp4``,
 ``snapshots.png`` (a strip of still frames) and ``plots.png``, and last of all
 ``summary.json``. Every file is written atomically, and a stale ``summary.json`` from an
-earlier run is removed before the new run starts, so an interrupted run never leaves a summary that looks complete.
+earlier run is removed before the new run starts, so an interrupted run never leaves a
+summary that looks complete.
 """
 
 from __future__ import annotations

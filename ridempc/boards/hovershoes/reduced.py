@@ -19,9 +19,9 @@ own text calls :math:`c_3` "the coefficient for the ground contact damping term"
 that nothing drives :math:`\\psi` back to zero (no internal yaw controller); a spring on the
 absolute heading would make a shoe on the ground steer back to a fixed world direction,
 which no tyre does. Physically :math:`c_3` is the tyre's rim friction resisting twist, here
-linearised around the identified yaw rates. The simulated rim friction is Coulomb-like (it sticks, then
-slides), so this linear law fits the held-out yaw rates to :math:`r^2 \\approx 0.9`, the
-pitch to 0.999.
+linearised around the identified yaw rates. The simulated rim friction is Coulomb-like (it
+sticks, then slides), so this linear law fits the held-out yaw rates to
+:math:`r^2 \\approx 0.9`, the pitch to 0.999.
 
 Every dynamics function takes an ``xp`` module (default :mod:`numpy`) and uses only
 arithmetic and ``xp.sin``/``xp.cos``, so ``import casadi as xp`` reuses them symbolically;
