@@ -53,6 +53,19 @@ def _parser() -> argparse.ArgumentParser:
 
     commands.add_parser("list", help="name the robots, boards, controllers and scenarios")
 
+    compare = commands.add_parser(
+        "compare", help="ride a scenario with the PD baseline and the MPC, same seeds, side by side"
+    )
+    compare.add_argument("--robot", required=True, help="robot name")
+    compare.add_argument("--board", required=True, help="board name")
+    compare.add_argument("--scenario", required=True, help="scenario name or .toml file")
+    compare.add_argument("--seeds", type=int, default=1, help="seeds 0..N-1 (default: 1)")
+    compare.add_argument(
+        "--controllers", default="pd,mpc", help="comma-separated controllers (default: pd,mpc)"
+    )
+    compare.add_argument("--duration", type=float, default=None, help="override duration [s]")
+    compare.add_argument("--out", type=Path, required=True, help="output folder")
+
     board = commands.add_parser("board", help="board tools")
     board_commands = board.add_subparsers(dest="board_command", required=True)
     identify = board_commands.add_parser(
@@ -99,6 +112,24 @@ def _library(args: argparse.Namespace) -> int:
     if args.library_command == "build":
         return library_build(args.robot, args.board, args.targets, args.jobs, args.out)
     return library_show(args.robot, args.board, args.dir, args.entry, args.plot)
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from ridempc.compare import compare
+
+    controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    rows = compare(
+        args.robot,
+        args.board,
+        args.scenario,
+        args.out,
+        seeds=args.seeds,
+        controllers=controllers,
+        duration=args.duration,
+    )
+    print(f"results in {args.out}")
+    failed = any(s["status"] == "failed" for r in rows for s in r.summaries)
+    return EXIT_FAILED if failed else 0
 
 
 def _list() -> int:
@@ -180,6 +211,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _identify(args)
         if args.command == "library":
             return _library(args)
+        if args.command == "compare":
+            return _compare(args)
         return _sim(args)
     except (UnknownNameError, ConfigError) as exc:
         print(f"ridempc: error: {exc}", file=sys.stderr)

@@ -11,7 +11,7 @@ from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["atomic_write", "atomic_write_json", "atomic_write_npz"]
+__all__ = ["atomic_write", "atomic_write_json", "atomic_write_npz", "atomic_write_text"]
 
 _UMASK = os.umask(0)
 os.umask(_UMASK)
@@ -34,13 +34,17 @@ def atomic_write(path: Path, write: Callable[[IO[bytes]], None]) -> None:
         raise
 
 
-def atomic_write_json(path: Path, payload: Mapping[str, Any]) -> None:
-    text = json.dumps(payload, indent=2, sort_keys=False, allow_nan=False) + "\n"
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write UTF-8 text atomically."""
 
     def write(stream: IO[bytes]) -> None:
         stream.write(text.encode())
 
     atomic_write(path, write)
+
+
+def atomic_write_json(path: Path, payload: Mapping[str, Any]) -> None:
+    atomic_write_text(path, json.dumps(payload, indent=2, sort_keys=False, allow_nan=False) + "\n")
 
 
 def atomic_write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:

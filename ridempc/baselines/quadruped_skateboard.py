@@ -104,6 +104,7 @@ from ridempc.boards.skateboard.parameters import (
 )
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError
+from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
@@ -276,6 +277,10 @@ class QuadrupedSkateboardPD(Controller):
         self._feedback = (0.0, 0.0)  # filtered feedback shift [m], [m/s]
         self._shift = (0.0, 0.0)  # commanded shift [m], [m/s]
         self._diagnostics: dict[str, float] = {}
+        # Not used by the control law (the deck is read from the feet above); it runs so that
+        # every ride reports the estimator's error against the truth.
+        feet = robot.params.foot_bodies
+        self.estimator = StateEstimator(robot, platforms=(feet,) if board != "none" else ())
 
     # ------------------------------------------------------------------ state
 
@@ -335,6 +340,7 @@ class QuadrupedSkateboardPD(Controller):
         self._roll_integral = 0.0
         self._feedback = (0.0, 0.0)
         self._shift = (0.0, 0.0)
+        self.estimator.reset(sensors)
         self._ready = True
 
     # ------------------------------------------------------------------ references
@@ -427,6 +433,8 @@ class QuadrupedSkateboardPD(Controller):
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         if not self._ready:
             self.reset(sensors)
+        else:
+            self.estimator.update(sensors)
         posture = self.gains.posture
         state = self.observe(sensors)
         shift, shift_rate = self.lateral_shift(sensors, command, state)
@@ -487,6 +495,9 @@ class QuadrupedSkateboardPD(Controller):
             unreachable_feet=float(unreachable),
         )
         return MotorCommand(torque=torque, position=position, velocity=velocity, kp=kp, kd=kd)
+
+    def estimate(self) -> EstimatedState | None:
+        return self.estimator.state
 
     def diagnostics(self) -> dict[str, float]:
         return dict(self._diagnostics)

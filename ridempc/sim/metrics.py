@@ -30,7 +30,7 @@ from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.simulation import RunResult
 
-__all__ = ["run_metrics"]
+__all__ = ["board_roll", "run_metrics"]
 
 
 def _tilt(quaternions: np.ndarray) -> np.ndarray:
@@ -39,7 +39,7 @@ def _tilt(quaternions: np.ndarray) -> np.ndarray:
     return np.arccos(np.clip(1.0 - 2.0 * (x**2 + y**2), -1.0, 1.0))
 
 
-def _roll(quaternions: np.ndarray) -> np.ndarray:
+def board_roll(quaternions: np.ndarray) -> np.ndarray:
     """Roll about the body's own x axis [rad] (z-y-x Euler angles), for (w, x, y, z)."""
     w, x, y, z = (quaternions[:, i] for i in range(4))
     return np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x**2 + y**2))
@@ -95,7 +95,7 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> d
         }
         metrics["peak_torque_ratio"] = float(np.max(peak / limits))
     if "board_quaternion" in log and _tracks(scenario, "roll"):
-        roll = _roll(log["board_quaternion"][:, 0])
+        roll = board_roll(log["board_quaternion"][:, 0])
         metrics["roll_rmse"] = _rmse(roll[window] - log["command_roll"][window])
     if "board_position" in log and log["board_position"].shape[1] == 2:
         spacing = _lateral_spacing(log["board_position"], log["yaw"])
