@@ -43,7 +43,9 @@ __all__ = [
     "CommandEvent",
     "CommandWave",
     "Disturbance",
+    "PUSH_OFF_WINDOW",
     "ParameterChange",
+    "PushOff",
     "Scenario",
     "load_scenario_file",
 ]
@@ -125,6 +127,21 @@ class ParameterChange(_Frozen):
     value: float
 
 
+class PushOff(_Frozen):
+    """A push-off from rest to a target speed (skateboard paper, the acceleration mode).
+
+    The ride's summary adds ``target_velocity`` and ``final_velocity``: the board's mean
+    horizontal speed over :math:`t_j \\pm` ``PUSH_OFF_WINDOW``/2, with :math:`t_j` =
+    ``judged_at``, the end of the push-off (a rolling board slows afterwards).
+    """
+
+    target: Annotated[float, Field(gt=0.0)]  # [m/s]
+    judged_at: Time  # [s]
+
+
+PUSH_OFF_WINDOW: float = 0.5  # [s]
+
+
 class Scenario(_Frozen):
     """A checked, immutable scenario."""
 
@@ -141,6 +158,7 @@ class Scenario(_Frozen):
     disturbances: tuple[Disturbance, ...] = ()
     changes: tuple[ParameterChange, ...] = ()
     noise: SensorNoise = SensorNoise()
+    push_off: PushOff | None = None
 
     @model_validator(mode="after")
     def _ordered(self) -> Scenario:

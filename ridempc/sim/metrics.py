@@ -14,6 +14,9 @@
   state estimate of the base velocity and position against the truth,
   :math:`\\sqrt{\\overline{\\|\\hat v - v\\|^2}}`, over the whole run (rows with an estimate),
   when the controller has an estimator;
+- ``target_velocity`` and ``final_velocity`` [m/s]: for a push-off scenario, its target and
+  the board's mean horizontal speed over ``PUSH_OFF_WINDOW`` about the scenario's
+  ``push_off.judged_at``;
 - ``controller_update_ms``: median and p99 of the controller's update time.
 
 Both RMSEs are taken over the samples from the scenario's ``metrics_start`` until the
@@ -27,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from ridempc.robots.robot import Robot
-from ridempc.scenarios.scenario import Scenario
+from ridempc.scenarios.scenario import PUSH_OFF_WINDOW, Scenario
 from ridempc.sim.simulation import RunResult
 
 __all__ = ["board_roll", "run_metrics"]
@@ -106,6 +109,12 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> d
         metrics["board_max_speed"] = float(
             np.max(np.linalg.norm(log["board_velocity"][..., :2], axis=-1))
         )
+    if scenario.push_off is not None and "board_velocity" in log:
+        push_off = scenario.push_off
+        judged = np.abs(log["time"] - push_off.judged_at) <= 0.5 * PUSH_OFF_WINDOW
+        speed = np.linalg.norm(log["board_velocity"][:, 0, :2], axis=-1)
+        metrics["target_velocity"] = push_off.target
+        metrics["final_velocity"] = float(np.mean(speed[judged])) if judged.any() else None
     if "estimate_base_velocity" in log:
         metrics.update(_estimator_errors(log))
     if result.controller_times.size:
