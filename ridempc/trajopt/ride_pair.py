@@ -31,7 +31,7 @@ from ridempc.trajopt.ride_problem import (
 )
 from ridempc.trajopt.rider import RiderModel, build_rider
 
-__all__ = ["make_ride_pair"]
+__all__ = ["make_ride_pair", "ride_models"]
 
 # Cassie's hips: the hip-pitch joints; legs between 85 % and 103 % of the riding stance's.
 HIPS = {"cassie": ("left_hip_pitch", "right_hip_pitch")}

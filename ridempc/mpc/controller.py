@@ -1,0 +1,208 @@
+"""The 30 Hz linear MPC of a robot-board pair: reference -> linearisation -> QP -> plan.
+
+Built once per pair and manoeuvre (:meth:`LinearMpc.from_library`): the pair's dynamics
+and their Jacobians (:func:`~ridempc.mpc.problem.build_linear_model`), the library
+reference (:func:`~ridempc.mpc.reference.select_reference`), the weights
+(:func:`~ridempc.mpc.weights.bryson_weights`) and the QP with its fixed sparsity
+(:class:`~ridempc.mpc.qp.MpcQP`). Each tick, :meth:`LinearMpc.update` samples the
+reference over the horizon, linearises at the estimated state, builds the friction
+pyramids with the surface rotations of that state, and solves:
+
+.. code-block:: python
+
+    mpc = LinearMpc.from_library("cyberdog2", "skateboard", "accelerate", 0.5)
+    plan = mpc.update(t, x0)   # t [s] since the manoeuvre began, x0 in the pair's layout
+    forces_and_rates = plan.first_input
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.errors import ConfigError
+from ridempc.mpc.friction import force_bounds, friction_pyramids, pyramid_pattern
+from ridempc.mpc.pairs import MpcPair, load_mpc_pair, surface_rotations
+from ridempc.mpc.plan import Plan
+from ridempc.mpc.problem import MPC_STEP, LinearModel, MpcProblem, build_linear_model, linearize
+from ridempc.mpc.qp import MpcQP, QPStructure
+from ridempc.mpc.reference import MotionReference, select_reference, steady_riding
+from ridempc.mpc.weights import bryson_weights
+
+__all__ = ["LinearMpc", "MpcSettings"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class MpcSettings:
+    """Settings of the MPC.
+
+    Attributes:
+        horizon: N, steps [-].
+        dt: Step [s] (30 Hz in the paper).
+        terminal_factor: :math:`Q_N = ` this :math:`\\times Q` [-].
+        weights: Overrides of :math:`Q` and :math:`R` by state or input name.
+        osqp: Overrides of the QP's OSQP settings.
+    """
+
+    horizon: int = 12
+    dt: float = MPC_STEP
+    terminal_factor: float = 10.0
+    weights: Mapping[str, float] = field(default_factory=dict)
+    osqp: Mapping[str, float | int | bool] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.horizon < 1:
+            raise ConfigError(f"MPC horizon must be at least 1 step, got {self.horizon}")
+        if not self.dt > 0.0:
+            raise ConfigError(f"MPC step must be positive, got {self.dt} s")
+        if not self.terminal_factor >= 0.0:
+            raise ConfigError(
+                f"MPC terminal factor must be non-negative, got {self.terminal_factor}"
+            )
+
+
+def _tolerance(weights: Array) -> Array:
+    """Bryson's tolerances back from the weights (the QP's scales); 1 for a zero weight."""
+    return np.where(weights > 0.0, 1.0 / np.sqrt(np.where(weights > 0.0, weights, 1.0)), 1.0)
+
+
+class LinearMpc:
+    """The MPC of one pair tracking one reference (see the module docstring).
+
+    Attributes:
+        pair: The pair's surfaces and limits.
+        reference: The trajectory tracked.
+        model: The pair's Jacobians.
+        settings: Horizon, step, weights.
+        state_weights: Diagonal of :math:`Q`.
+        input_weights: Diagonal of :math:`R`.
+        qp: The QP (built by the first :meth:`update`).
+    """
+
+    def __init__(
+        self,
+        pair: MpcPair,
+        reference: MotionReference,
+        model: LinearModel,
+        settings: MpcSettings | None = None,
+    ) -> None:
+        if reference.contact_names != pair.contacts:
+            raise ConfigError(
+                f"reference '{reference.name}' has contacts {reference.contact_names}, the "
+                f"pair {pair.pair.name} {pair.contacts}"
+            )
+        self.pair = pair
+        self.reference = reference
+        self.model = model
+        self.settings = settings or MpcSettings()
+        self.state_weights, self.input_weights = bryson_weights(
+            reference.state_names,
+            reference.input_names,
+            pair.weight / len(pair.contacts),
+            self.settings.weights,
+        )
+        self.structure = QPStructure(
+            model.state_pattern,
+            model.input_pattern,
+            pyramid_pattern(reference.force_index, model.nu),
+        )
+        self.qp: MpcQP | None = None
+
+    @classmethod
+    def from_library(
+        cls,
+        robot: str,
+        board: str,
+        kind: str,
+        target: float,
+        settings: MpcSettings | None = None,
+        folder: Path | None = None,
+    ) -> LinearMpc:
+        """The MPC of ``robot`` on ``board`` tracking the library's ``kind`` at ``target``.
+
+        Raises:
+            UnknownNameError: No MPC for that pair.
+            ConfigError: The library is missing, corrupt, or has no such kind.
+        """
+        pair = load_mpc_pair(robot, board)
+        reference = select_reference(robot, board, kind, target, folder=folder)
+        rates = pair.pair.rates(reference.metadata)
+        return cls(pair, steady_riding(reference, rates), build_linear_model(rates), settings)
+
+    def retarget(self, kind: str, target: float, folder: Path | None = None) -> None:
+        """Track another library trajectory of the same pair, keeping the Jacobians and the
+        QP (its pattern depends on the pair only); times restart at its beginning.
+
+        Raises:
+            ConfigError: As :meth:`from_library`, or the entry's contacts differ.
+        """
+        pair = self.pair.pair
+        reference = select_reference(pair.robot, pair.board, kind, target, folder=folder)
+        if reference.contact_names != self.reference.contact_names:
+            raise ConfigError(
+                f"reference '{reference.name}' has contacts {reference.contact_names}, "
+                f"expected {self.reference.contact_names}"
+            )
+        self.reference = steady_riding(reference, self.model.rates)
+
+    def problem(self, t: float, x0: Array) -> MpcProblem:
+        """The MPC problem at time ``t`` [s] (since the reference's start) from ``x0``."""
+        s = self.settings
+        x0 = np.asarray(x0, dtype=float).ravel()
+        window = self.reference.sample(t, s.horizon, s.dt)
+        dynamics = linearize(self.model, x0, window.inputs, window.parameters, s.dt)
+        surfaces = surface_rotations(self.pair, x0)
+        index = self.reference.force_index
+        g, g_lo, g_hi = friction_pyramids(
+            index,
+            self.model.nu,
+            window.contacts,
+            surfaces,
+            self.reference.friction,
+            self.pair.max_force,
+        )
+        u_lo, u_hi = force_bounds(index, window.contacts, self.pair.input_limits)
+        return MpcProblem(
+            initial_state=x0,
+            A=dynamics.A,
+            B=dynamics.B,
+            c=dynamics.c,
+            state_reference=window.states,
+            input_reference=window.inputs,
+            state_weights=self.state_weights,
+            input_weights=self.input_weights,
+            input_lower=u_lo,
+            input_upper=u_hi,
+            constraint_matrix=g,
+            constraint_lower=g_lo,
+            constraint_upper=g_hi,
+            dt=s.dt,
+            terminal_weights=s.terminal_factor * self.state_weights,
+        )
+
+    def build_qp(self, problem: MpcProblem, **osqp: float | int | bool) -> MpcQP:
+        """A QP for this MPC's problems: the pair's fixed pattern, scaled by the weights'
+        tolerances, OSQP set up with ``settings.osqp`` and ``osqp`` over the defaults."""
+        return MpcQP(
+            problem,
+            self.structure,
+            state_scale=_tolerance(self.state_weights),
+            input_scale=_tolerance(self.input_weights),
+            **{**dict(self.settings.osqp), **osqp},
+        )
+
+    def update(self, t: float, x0: Array) -> Plan:
+        """One MPC tick: the plan from the estimated state ``x0`` at time ``t`` [s].
+
+        The first call builds the QP; later calls write new values into it.
+        """
+        problem = self.problem(t, x0)
+        if self.qp is None:
+            self.qp = self.build_qp(problem)
+        return self.qp.solve(problem)

@@ -1,0 +1,104 @@
+"""Contact constraints of the MPC: friction pyramids in each contact's surface frame.
+
+For a contact :math:`i` touching a surface of rotation :math:`R_i` (the deck or platform
+under it, or the ground's identity), the force on the robot in the surface frame,
+:math:`\\phi_i = R_i^\\top f_i` [N], satisfies
+
+.. math::
+
+    0 \\le \\phi_{i,z} \\le f_{max}, \\qquad
+    |\\phi_{i,x}| \\le \\mu\\, \\phi_{i,z}, \\qquad |\\phi_{i,y}| \\le \\mu\\, \\phi_{i,z}
+
+five rows :math:`g^{lo} \\le G u \\le g^{hi}` per contact and step. A swinging contact gets
+:math:`f_{max} = 0`, so the same rows pin its force to zero: every step has the same rows
+with the same sparsity, whatever the contact schedule, which is what lets the QP keep one
+pattern. As in the paper (Sec. V-B), the rotations are those of the estimated state, held
+over the horizon.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.trajopt.schedule import Contact
+
+__all__ = ["ROWS_PER_CONTACT", "force_bounds", "friction_pyramids", "pyramid_pattern"]
+
+Array = NDArray[np.float64]
+ROWS_PER_CONTACT = 5
+
+# Rows of one pyramid on the local force (phi_x, phi_y, phi_z), with mu = 1 for the shape;
+# the mu column multiplies phi_z.
+_TANGENT = np.array(
+    [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]]
+)
+_NORMAL = np.array([0.0, -1.0, -1.0, -1.0, -1.0])
+
+
+def pyramid_pattern(force_index: NDArray[np.int64], nu: int) -> NDArray[np.bool_]:
+    """Structural non-zeros of :math:`G_k` (5 n_c x nu): each row on its contact's force."""
+    pattern = np.zeros((ROWS_PER_CONTACT * len(force_index), nu), dtype=bool)
+    for i, columns in enumerate(force_index):
+        pattern[ROWS_PER_CONTACT * i : ROWS_PER_CONTACT * (i + 1), columns] = True
+    return pattern
+
+
+def friction_pyramids(
+    force_index: NDArray[np.int64],
+    nu: int,
+    schedule: Sequence[Sequence[Contact]],
+    surfaces: Array,
+    friction: float,
+    max_force: float,
+) -> tuple[Array, Array, Array]:
+    """Friction pyramids of every step (see the module docstring).
+
+    Args:
+        force_index: Per contact, the input indices of its force (x, y, z), n_c x 3.
+        nu: Input size.
+        schedule: Per step, per contact, where it is (board, ground or swing), N x n_c.
+        surfaces: Per contact, the rotation of the board surface under it (world from
+            surface), n_c x 3 x 3; a contact on the ground uses the identity.
+        friction: :math:`\\mu` [-].
+        max_force: :math:`f_{max}` [N].
+
+    Returns:
+        :math:`G` (N x 5 n_c x nu), :math:`g^{lo}`, :math:`g^{hi}` (N x 5 n_c).
+    """
+    n, nc = len(schedule), len(force_index)
+    rows = ROWS_PER_CONTACT * nc
+    matrix = np.zeros((n, rows, nu))
+    lower = np.full((n, rows), -np.inf)
+    upper = np.zeros((n, rows))
+    local = _TANGENT.copy()
+    local[:, 2] += friction * _NORMAL  # rows on phi: (phi_z, phi_x - mu phi_z, ...)
+    for k, contacts in enumerate(schedule):
+        for i, kind in enumerate(contacts):
+            rotation = surfaces[i] if kind is Contact.BOARD else np.eye(3)
+            block = slice(ROWS_PER_CONTACT * i, ROWS_PER_CONTACT * (i + 1))
+            matrix[k, block][:, force_index[i]] = local @ rotation.T  # a^T R^T f
+            lower[k, block.start] = 0.0
+            upper[k, block.start] = 0.0 if kind is Contact.SWING else max_force
+    return matrix, lower, upper
+
+
+def force_bounds(
+    force_index: NDArray[np.int64],
+    schedule: Sequence[Sequence[Contact]],
+    limits: Array,
+) -> tuple[Array, Array]:
+    """Box bounds of the inputs per step: ``limits`` (nu, symmetric, inf for none), and zero
+    force on a swinging contact.
+
+    Returns:
+        :math:`u^{lo}`, :math:`u^{hi}` (N x nu).
+    """
+    upper = np.tile(np.asarray(limits, dtype=float), (len(schedule), 1))
+    for k, contacts in enumerate(schedule):
+        for i, kind in enumerate(contacts):
+            if kind is Contact.SWING:
+                upper[k, force_index[i]] = 0.0
+    return -upper, upper

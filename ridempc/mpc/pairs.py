@@ -1,0 +1,107 @@
+"""What the MPC needs from a robot-board pair besides its library: surfaces, limits.
+
+The dynamics come from the pair's trajectory-optimisation module
+(:data:`ridempc.trajopt.pairs.PAIRS`, ``Pair.rates``); what the library entries do not
+carry is, per contact, the rotation of the board surface it stands on (for the friction
+pyramids) and the limits of the inputs that are not forces (joint speeds, the Segway's knee
+bar). Each pair's builder reads them from the same models the optimisation used, so the
+MPC's constraints are the library's. The table :data:`MPC_PAIRS` maps
+``<robot>-<board>`` to its builder: a new pair is a builder and one line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import cache, partial
+from typing import NamedTuple
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.errors import UnknownNameError
+from ridempc.trajopt.pairs import Pair, load_pair
+from ridempc.trajopt.ride_pair import ride_models
+from ridempc.trajopt.ride_problem import ride_layout
+from ridempc.trajopt.rigid_body import GRAVITY
+from ridempc.trajopt.skate_pair import skate_models
+from ridempc.trajopt.skateboard import BOARD_STATE, deck_frame
+
+__all__ = ["MPC_PAIRS", "MpcPair", "load_mpc_pair", "surface_rotations"]
+
+Array = NDArray[np.float64]
+
+
+class MpcPair(NamedTuple):
+    """A pair as the MPC sees it.
+
+    Attributes:
+        pair: The trajectory-optimisation pair (its ``rates`` rebuild the dynamics).
+        contacts: Contact names, in the order of the library's force inputs.
+        surfaces: CasADi function :math:`x \\mapsto [R_1 \\dots R_{n_c}]` (3 x 3 n_c): per
+            contact, the rotation (world from surface) of the deck or platform it stands
+            on, in the library's contact order.
+        input_limits: Symmetric bound of each input (nu), inf where the friction pyramids
+            bound it (the forces) [rad/s], [rad].
+        max_force: Largest normal force of one contact, :math:`f_{max}` [N] (the library's).
+        weight: The robot's weight [N] (forces are weighed in units of its share per contact).
+    """
+
+    pair: Pair
+    contacts: tuple[str, ...]
+    surfaces: ca.Function
+    input_limits: Array
+    max_force: float
+    weight: float
+
+
+def surface_rotations(pair: MpcPair, x0: Array) -> Array:
+    """Per contact, the surface rotation at the state ``x0``, n_c x 3 x 3."""
+    stacked = np.asarray(pair.surfaces(np.asarray(x0, dtype=float)))
+    return stacked.reshape(3, -1, 3).transpose(1, 0, 2)
+
+
+def _skateboard() -> MpcPair:
+    robot, board = skate_models()
+    nf, nr = robot.n_feet, 12 + robot.n_joints
+    x = ca.SX.sym("x", nr + len(BOARD_STATE))
+    rotation, _ = deck_frame(board, x[nr:])
+    surfaces = ca.Function("contact_surfaces", [x], [ca.horzcat(*[rotation] * nf)])
+    limits = np.concatenate([np.full(3 * nf, np.inf), robot.speed_limit])
+    # The library's bound on each force component (skate_problem: twice the weight).
+    pair = load_pair(robot.name, "skateboard")
+    weight = robot.mass * GRAVITY
+    return MpcPair(pair, robot.feet, surfaces, limits, 2.0 * weight, weight)
+
+
+def _ride(robot: str, board: str) -> MpcPair:
+    rider, wheeled = ride_models(robot, board)
+    layout = ride_layout(rider, wheeled)
+    x = ca.SX.sym("x", 12 + len(wheeled.state_names))
+    rotations = [wheeled.pose(x[12:], platform)[0] for platform in layout["platform_of"]]
+    surfaces = ca.Function("contact_surfaces", [x], [ca.horzcat(*rotations)])
+    limits = np.concatenate([np.full(3 * rider.n_contacts, np.inf), wheeled.input_bound])
+    # The library's bound: one contact may carry the whole weight (ride_problem).
+    pair = load_pair(robot, board)
+    weight = rider.body.mass * GRAVITY
+    return MpcPair(pair, rider.contacts, surfaces, limits, weight, weight)
+
+
+MPC_PAIRS: dict[str, Callable[[], MpcPair]] = {
+    "cyberdog2-skateboard": _skateboard,
+    "cassie-hovershoes": partial(_ride, "cassie", "hovershoes"),
+    "cassie-segway": partial(_ride, "cassie", "segway"),
+}
+
+
+@cache
+def load_mpc_pair(robot: str, board: str) -> MpcPair:
+    """The MPC's view of a pair (built once per process).
+
+    Raises:
+        UnknownNameError: No MPC for that pair; the message lists those that have one.
+    """
+    name = f"{robot}-{board}"
+    if name not in MPC_PAIRS:
+        raise UnknownNameError("robot-board pair for the MPC", name, MPC_PAIRS)
+    return MPC_PAIRS[name]()

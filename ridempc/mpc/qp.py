@@ -1,0 +1,406 @@
+"""The MPC's QP: sparse over states and inputs, built once, updated in place, solved by OSQP.
+
+Decision vector :math:`z = (x_0, \\dots, x_N, u_0, \\dots, u_{N-1})` (not condensed: the
+dynamics stay equality rows, so the KKT system is sparse and banded). Eq. (19) becomes
+
+.. math::
+
+    \\min_z \\tfrac12 (z - z^{ref})^\\top P (z - z^{ref}), \\quad
+    P = \\mathrm{diag}(0, Q, \\dots, Q, Q_N, R, \\dots, R)
+
+subject to :math:`l \\le A_{qp} z \\le u` with the rows, step by step:
+
+- :math:`x_0 = \\hat x_0` (nx rows);
+- :math:`x_{k+1} - A_k x_k - B_k u_k = c_k` (eq. 18, nx rows per step);
+- :math:`u^{lo}_k \\le u_k \\le u^{hi}_k` (nu rows per step);
+- :math:`g^{lo}_k \\le G_k u_k \\le g^{hi}_k` (the friction pyramids, m rows per step).
+
+OSQP solves for the scaled deviation from the reference,
+:math:`\\tilde z = D^{-1} (z - z^{ref})` with :math:`D` the state and input scales (forces
+in units of the weight per contact), the rows of the dynamics and of the boxes are divided
+by the scale of their state or input, and the polyhedral rows by their largest
+coefficient: its tolerances then apply to quantities of order one whatever the units and
+however far the robot has travelled (and the linear cost term is zero).
+
+The sparsity of :math:`A_{qp}` is fixed when the QP is built: the structural non-zeros of
+:math:`A_k`, :math:`B_k` and :math:`G_k` (from the pair's Jacobians and the pyramids, see
+:class:`QPStructure`), stored even where a value happens to be zero. An update writes the
+new values into that pattern (``Px``, ``Ax``, ``l``, ``u`` of OSQP's ``update``),
+OSQP is set up once, and each solve is warm-started from the previous plan shifted by one
+step (primal and dual). A solve that does not end ``solved`` within the time limit returns
+the previous plan shifted by one step, flagged as a fallback, and counts as a failure.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+import osqp
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from ridempc.mpc.plan import Plan, shift_plan
+from ridempc.mpc.problem import MpcProblem
+
+__all__ = ["DEFAULT_SETTINGS", "MpcQP", "QPStructure", "SolveRecord"]
+
+Array = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+IntArray = NDArray[np.int64]
+
+# OSQP settings. The QP is scaled here (module docstring), so eps of 1e-4 is 1e-4 of each
+# state's and input's tolerance, and OSQP's own equilibration, which it would redo at every
+# matrix update (0.3 ms), is off. Polishing is off too: on these problems it mostly fails
+# and costs a factorisation. rho = 0.3 took the fewest iterations on all three pairs. The
+# time limit leaves most of the 33 ms period to the rest of the controller.
+DEFAULT_SETTINGS: dict[str, Any] = {
+    "verbose": False,
+    "eps_abs": 1e-4,
+    "eps_rel": 1e-4,
+    "max_iter": 4000,
+    "rho": 0.3,
+    "scaling": 0,
+    "check_termination": 10,
+    "polishing": False,
+    "warm_starting": True,
+    "time_limit": 0.02,  # [s]
+}
+_SOLVED = osqp.SolverStatus.OSQP_SOLVED
+_PATTERN_TOLERANCE = 1e-9  # values this small outside the pattern are round-off
+
+
+@dataclass(frozen=True)
+class QPStructure:
+    """Which entries of the per-step matrices may be non-zero (fixed when the QP is built).
+
+    Attributes:
+        state_pattern: Of :math:`A_k` (nx x nx).
+        input_pattern: Of :math:`B_k` (nx x nu).
+        constraint_pattern: Of :math:`G_k` (m x nu).
+    """
+
+    state_pattern: BoolArray
+    input_pattern: BoolArray
+    constraint_pattern: BoolArray
+
+    @classmethod
+    def of(cls, problem: MpcProblem) -> QPStructure:
+        """The non-zeros of one problem (any step), with the diagonal of :math:`A_k`."""
+        state = np.any(problem.A != 0.0, axis=0) | np.eye(problem.nx, dtype=bool)
+        return cls(
+            state,
+            np.any(problem.B != 0.0, axis=0),
+            np.any(problem.constraint_matrix != 0.0, axis=0),
+        )
+
+
+class SolveRecord(NamedTuple):
+    """One solve: OSQP's status, wall time [s], iterations, and whether it fell back."""
+
+    status: str
+    solve_time: float
+    iterations: int
+    fallback: bool
+
+
+class MpcQP:
+    """The sparse MPC QP, built once for a horizon, sizes and :class:`QPStructure`.
+
+    Attributes:
+        horizon: N.
+        nx: State size.
+        nu: Input size.
+        n_constraints: Polyhedral rows per step, m.
+        structure: The fixed sparsity.
+        history: One :class:`SolveRecord` per :meth:`solve`.
+        failures: Solves that fell back.
+    """
+
+    def __init__(
+        self,
+        problem: MpcProblem,
+        structure: QPStructure | None = None,
+        state_scale: Array | None = None,
+        input_scale: Array | None = None,
+        **settings: Any,
+    ) -> None:
+        """Build the QP's pattern from ``problem`` (and ``structure``) and set up OSQP.
+
+        Args:
+            problem: A first problem: its sizes and values initialise the QP.
+            structure: The sparsity every later problem stays within (default: the
+                non-zeros of ``problem``).
+            state_scale: Typical size of each state's deviation (nx, default ones).
+            input_scale: Typical size of each input's deviation (nu, default ones), e.g.
+                the weight per contact [N] for the forces.
+            settings: OSQP settings over :data:`DEFAULT_SETTINGS`.
+        """
+        self.horizon, self.nx, self.nu = problem.horizon, problem.nx, problem.nu
+        self.n_constraints = problem.n_constraints
+        self.structure = structure or QPStructure.of(problem)
+        self._check_structure()
+        self.settings = {**DEFAULT_SETTINGS, **settings}
+        self.time_limit = float(self.settings["time_limit"])
+        self.history: list[SolveRecord] = []
+        self.failures = 0
+        self._previous: Plan | None = None
+        self._previous_dual: Array | None = None
+        n = self.horizon
+        sx = np.ones(self.nx) if state_scale is None else np.asarray(state_scale, dtype=float)
+        su = np.ones(self.nu) if input_scale is None else np.asarray(input_scale, dtype=float)
+        if sx.shape != (self.nx,) or su.shape != (self.nu,) or min(sx.min(), su.min()) <= 0:
+            raise ValueError("MpcQP: scales must be positive, one per state and per input")
+        self._scale = np.concatenate([np.tile(sx, n + 1), np.tile(su, n)])
+        # Rows in scaled units: states' rows by their scale, boxes by the inputs'.
+        self._row_scale = 1.0 / np.concatenate(
+            [np.tile(sx, n + 1), np.tile(su, n), np.ones(n * self.n_constraints)]
+        )
+        self._input_scale = su
+        self._build_pattern()
+        hessian, csc = self.matrices(problem)
+        _, lower, upper = self._data(problem)
+        self._solver = osqp.OSQP()
+        self._solver.setup(hessian, np.zeros(self.n_variables), csc, lower, upper, **self.settings)
+
+    @property
+    def n_variables(self) -> int:
+        return (self.horizon + 1) * self.nx + self.horizon * self.nu
+
+    @property
+    def n_rows(self) -> int:
+        n = self.horizon
+        return self.nx + n * (self.nx + self.nu + self.n_constraints)
+
+    @property
+    def nnz(self) -> int:
+        """Stored entries of :math:`A_{qp}` (fixed)."""
+        return len(self._indices)
+
+    @property
+    def pattern(self) -> tuple[IntArray, IntArray]:
+        """CSC ``indices`` and ``indptr`` of :math:`A_{qp}` (fixed)."""
+        return self._indices.copy(), self._indptr.copy()
+
+    def _check_structure(self) -> None:
+        s, nx, nu = self.structure, self.nx, self.nu
+        for name, got, expected in (
+            ("state_pattern", s.state_pattern.shape, (nx, nx)),
+            ("input_pattern", s.input_pattern.shape, (nx, nu)),
+            ("constraint_pattern", s.constraint_pattern.shape, (self.n_constraints, nu)),
+        ):
+            if got != expected:
+                raise ValueError(f"MpcQP: {name} has shape {got}, expected {expected}")
+
+    def _build_pattern(self) -> None:
+        """COO triplets of :math:`A_{qp}`, each pointing into the value vector of
+        :meth:`_data`, sorted once into CSC order."""
+        n, nx, nu, m = self.horizon, self.nx, self.nu, self.n_constraints
+        s = self.structure
+        x_at = np.arange(n + 1) * nx
+        u_at = (n + 1) * nx + np.arange(n) * nu
+        rows: list[IntArray] = []
+        cols: list[IntArray] = []
+        eye_x, eye_u = np.arange(nx), np.arange(nu)
+        # Identities (value 1): x_0, x_{k+1} in the dynamics, u_k in the boxes.
+        rows.append(eye_x)
+        cols.append(eye_x)
+        for k in range(n):
+            rows.append(nx + k * nx + eye_x)
+            cols.append(x_at[k + 1] + eye_x)
+        box_at = nx + n * nx
+        for k in range(n):
+            rows.append(box_at + k * nu + eye_u)
+            cols.append(u_at[k] + eye_u)
+        n_ones = sum(len(r) for r in rows)
+        self._a_rows, self._a_cols = np.nonzero(s.state_pattern)
+        self._b_rows, self._b_cols = np.nonzero(s.input_pattern)
+        self._g_rows, self._g_cols = np.nonzero(s.constraint_pattern)
+        for k in range(n):
+            rows.append(nx + k * nx + self._a_rows)
+            cols.append(x_at[k] + self._a_cols)
+        for k in range(n):
+            rows.append(nx + k * nx + self._b_rows)
+            cols.append(u_at[k] + self._b_cols)
+        poly_at = box_at + n * nu
+        for k in range(n):
+            rows.append(poly_at + k * m + self._g_rows)
+            cols.append(u_at[k] + self._g_cols)
+        all_rows, all_cols = np.concatenate(rows), np.concatenate(cols)
+        order = np.lexsort((all_rows, all_cols))
+        self._source = order  # value-vector index of each CSC entry
+        self._indices = all_rows[order].astype(np.int64)
+        self._columns = all_cols[order]
+        counts = np.bincount(all_cols, minlength=self.n_variables)
+        self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        self._ones = np.ones(n_ones)
+        # Shift by one step, for warm starts: new index -> old index.
+        steps = np.minimum(np.arange(n + 1) + 1, n)
+        x_shift = (steps[:, None] * nx + eye_x).ravel()
+        u_shift = ((n + 1) * nx + np.minimum(np.arange(n) + 1, n - 1)[:, None] * nu + eye_u).ravel()
+        self._primal_shift = np.concatenate([x_shift, u_shift])
+        block = np.minimum(np.arange(n) + 1, n - 1)
+        self._dual_shift = np.concatenate(
+            [
+                eye_x,
+                (nx + block[:, None] * nx + eye_x).ravel(),
+                (box_at + block[:, None] * nu + eye_u).ravel(),
+                (poly_at + block[:, None] * m + np.arange(m)).ravel(),
+            ]
+        )
+
+    def _outside(self, name: str, values: Array, pattern: BoolArray) -> None:
+        stray = np.abs(values[:, ~pattern])
+        if stray.size and stray.max() > _PATTERN_TOLERANCE * max(1.0, np.abs(values).max()):
+            raise ValueError(
+                f"MpcQP: {name} has a non-zero outside the QP's fixed pattern "
+                f"(largest {stray.max():.3g}); build the QP with a QPStructure covering it"
+            )
+
+    def _data(self, problem: MpcProblem) -> tuple[Array, Array, Array]:
+        """Values of :math:`A_{qp} D` (rows scaled) in CSC order, and the bounds of
+        :math:`\\tilde z` (see the module docstring)."""
+        s = self.structure
+        self._outside("A", problem.A, s.state_pattern)
+        self._outside("B", problem.B, s.input_pattern)
+        self._outside("constraint_matrix", problem.constraint_matrix, s.constraint_pattern)
+        g = problem.constraint_matrix
+        largest = np.abs(g * self._input_scale).max(axis=2)  # N x m
+        row_scale = self._row_scale.copy()
+        row_scale[self.n_rows - g.shape[0] * g.shape[1] :] = (
+            1.0 / np.where(largest > 0.0, largest, 1.0).ravel()
+        )
+        values = np.concatenate(
+            [
+                self._ones,
+                -problem.A[:, self._a_rows, self._a_cols].ravel(),
+                -problem.B[:, self._b_rows, self._b_cols].ravel(),
+                g[:, self._g_rows, self._g_cols].ravel(),
+            ]
+        )[self._source]
+        values *= self._scale[self._columns] * row_scale[self._indices]
+        x_ref, u_ref = problem.state_reference, problem.input_reference
+        at_reference = np.concatenate(
+            [
+                x_ref[0],
+                (
+                    x_ref[1:]
+                    - np.einsum("kij,kj->ki", problem.A, x_ref[:-1])
+                    - np.einsum("kij,kj->ki", problem.B, u_ref)
+                ).ravel(),
+                u_ref.ravel(),
+                np.einsum("kij,kj->ki", g, u_ref).ravel(),
+            ]
+        )
+        x0, c = problem.initial_state, problem.c.ravel()
+        lower = np.concatenate(
+            [x0, c, problem.input_lower.ravel(), problem.constraint_lower.ravel()]
+        )
+        upper = np.concatenate(
+            [x0, c, problem.input_upper.ravel(), problem.constraint_upper.ravel()]
+        )
+        return values, (lower - at_reference) * row_scale, (upper - at_reference) * row_scale
+
+    def _weights(self, problem: MpcProblem) -> Array:
+        """Diagonal of :math:`D P D`."""
+        n = self.horizon
+        weights = np.concatenate(
+            [
+                np.zeros(self.nx),  # x_0 is fixed by its rows
+                np.tile(problem.state_weights, n - 1),
+                problem.final_weights,
+                np.tile(problem.input_weights, n),
+            ]
+        )
+        return weights * self._scale**2
+
+    @staticmethod
+    def _reference(problem: MpcProblem) -> Array:
+        return np.concatenate([problem.state_reference.ravel(), problem.input_reference.ravel()])
+
+    def _check_sizes(self, problem: MpcProblem) -> None:
+        sizes = (problem.horizon, problem.nx, problem.nu, problem.n_constraints)
+        if sizes != (self.horizon, self.nx, self.nu, self.n_constraints):
+            raise ValueError(
+                f"MpcQP: problem of sizes (N, nx, nu, m) = {sizes}, the QP was built for "
+                f"{(self.horizon, self.nx, self.nu, self.n_constraints)}"
+            )
+
+    def matrices(self, problem: MpcProblem) -> tuple[sp.csc_matrix, sp.csc_matrix]:
+        """The scaled :math:`P` and :math:`A_{qp}` that ``problem`` writes into the QP, on the
+        fixed pattern (for tests and inspection; :meth:`update` passes only their values).
+
+        Raises:
+            ValueError: As :meth:`update`.
+        """
+        self._check_sizes(problem)
+        values, _, _ = self._data(problem)
+        n = self.n_variables
+        hessian = sp.csc_matrix((self._weights(problem), np.arange(n), np.arange(n + 1)), (n, n))
+        constraints = sp.csc_matrix(
+            (values, self._indices.copy(), self._indptr.copy()), shape=(self.n_rows, n)
+        )
+        return hessian, constraints
+
+    def update(self, problem: MpcProblem) -> None:
+        """Write ``problem``'s values into the fixed pattern (no new setup).
+
+        Raises:
+            ValueError: Sizes differ from the QP's, or a matrix has a non-zero outside
+                the QP's :class:`QPStructure` (a wrong pair, not a solver failure).
+        """
+        self._check_sizes(problem)
+        values, lower, upper = self._data(problem)
+        self._solver.update(Px=self._weights(problem), Ax=values, l=lower, u=upper)
+
+    def _unpack(self, z: Array) -> tuple[Array, Array]:
+        n, nx = self.horizon, self.nx
+        states = z[: (n + 1) * nx].reshape(n + 1, nx)
+        inputs = z[(n + 1) * nx :].reshape(n, self.nu)
+        return states, inputs
+
+    def solve(self, problem: MpcProblem) -> Plan:
+        """Update the QP with ``problem``, warm-start it, solve it (see the module docstring).
+
+        Never raises for a failed solve: an infeasible problem, a solver error or a solve
+        beyond the time limit returns the previous plan shifted by one step (or, before
+        any plan, the problem's reference) with ``fallback`` set.
+
+        Raises:
+            ValueError: As :meth:`update`.
+        """
+        start = time.perf_counter()
+        self.update(problem)
+        reference = self._reference(problem)
+        if self._previous is not None:
+            states, inputs = self._previous.states, self._previous.inputs
+            z = np.concatenate([states.ravel(), inputs.ravel()])[self._primal_shift]
+            y = None if self._previous_dual is None else self._previous_dual[self._dual_shift]
+            self._solver.warm_start(x=(z - reference) / self._scale, y=y)
+        try:
+            result = self._solver.solve(raise_error=False)
+            status, iterations = str(result.info.status), int(result.info.iter)
+            ok = result.info.status_val == _SOLVED
+        except (osqp.OSQPException, ValueError) as exc:
+            status, iterations, ok = f"solver error ({exc!r})", 0, False
+        elapsed = time.perf_counter() - start
+        if ok and elapsed > self.time_limit:
+            status, ok = f"time limit exceeded ({elapsed * 1e3:.1f} ms)", False
+        if ok:
+            z = reference + self._scale * np.asarray(result.x, dtype=float)
+            states, inputs = self._unpack(z)
+            plan = Plan(states, inputs, inputs[0].copy(), status, elapsed, False, iterations)
+            self._previous_dual = np.asarray(result.y, dtype=float).copy()
+        else:
+            self.failures += 1
+            if self._previous is not None:
+                plan = shift_plan(self._previous, status, elapsed, iterations)
+            else:
+                u_ref = problem.input_reference
+                x_ref = problem.state_reference
+                plan = Plan(x_ref.copy(), u_ref.copy(), u_ref[0].copy(), status, elapsed, True)
+        self._previous = plan
+        self.history.append(SolveRecord(status, elapsed, iterations, plan.fallback))
+        return plan

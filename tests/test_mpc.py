@@ -1,0 +1,366 @@
+"""The 30 Hz linear MPC (ridempc.mpc): linearisation against finite differences, the QP built
+once with a fixed pattern, closed loops on the reduced models of the skateboard and the
+Hovershoes, the fallback of a failed solve, and the library reference's checks."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from ridempc.errors import ConfigError, UnknownNameError
+from ridempc.library.store import library_folder
+from ridempc.mpc import (
+    MPC_STEP,
+    LinearMpc,
+    MpcProblem,
+    MpcSettings,
+    build_linear_model,
+    linearize,
+    load_mpc_pair,
+    select_reference,
+)
+from ridempc.mpc.friction import ROWS_PER_CONTACT
+from ridempc.trajopt.schedule import Contact
+
+PAIRS = [
+    ("cyberdog2", "skateboard", "accelerate", 0.3),
+    ("cassie", "hovershoes", "accelerate", 0.5),
+]
+
+
+@pytest.fixture(scope="module")
+def skate_mpc() -> LinearMpc:
+    return LinearMpc.from_library("cyberdog2", "skateboard", "accelerate", 0.3)
+
+
+def _finite_difference(function, point: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    columns = []
+    for j in range(len(point)):
+        delta = np.zeros_like(point)
+        delta[j] = step
+        columns.append((function(point + delta) - function(point - delta)) / (2 * step))
+    return np.column_stack(columns)
+
+
+@pytest.mark.parametrize("robot, board, kind, target", PAIRS)
+def test_linearisation_matches_finite_differences(
+    robot: str, board: str, kind: str, target: float
+) -> None:
+    mpc = LinearMpc.from_library(robot, board, kind, target)
+    rates, reference = mpc.model.rates, mpc.reference
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        k = int(rng.integers(len(reference.inputs)))
+        x0 = reference.states[k] + rng.normal(scale=0.02, size=reference.states.shape[1])
+        u = reference.inputs[k] + rng.normal(scale=1.0, size=reference.inputs.shape[1])
+        p = reference.parameters[k]
+
+        def f(x: np.ndarray, u: np.ndarray = u, p: np.ndarray = p) -> np.ndarray:
+            return np.asarray(rates(x, u, p)).ravel()
+
+        _, jac_x, jac_u = (np.asarray(m) for m in mpc.model.jacobians(x0, u, p))
+        np.testing.assert_allclose(jac_x, _finite_difference(f, x0), rtol=1e-5, atol=1e-5)
+        by_input = _finite_difference(lambda v, x0=x0: f(x0, v), u)
+        np.testing.assert_allclose(jac_u, by_input, rtol=1e-5, atol=1e-6)
+        # Discrete: zero-order hold of the affine model, against SciPy's expm of the
+        # augmented matrix (eq. 18).
+        dt = MPC_STEP
+        a_d, b_d, c_d = linearize(mpc.model, x0, u[None, :], p[None, :], dt)
+        nx, nu = jac_u.shape
+        augmented = np.zeros((nx + nu + 1, nx + nu + 1))
+        augmented[:nx, :nx], augmented[:nx, nx : nx + nu] = jac_x * dt, jac_u * dt
+        augmented[:nx, -1] = f(x0) * dt
+        exact = expm(augmented)
+        np.testing.assert_allclose(a_d[0], exact[:nx, :nx], rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(b_d[0], exact[:nx, nx : nx + nu], rtol=1e-9, atol=1e-9)
+        # At the operating point the step is the linear model's: x0 + g.
+        np.testing.assert_allclose(
+            a_d[0] @ x0 + b_d[0] @ u + c_d[0], x0 + exact[:nx, -1], rtol=1e-9, atol=1e-9
+        )
+    # The paper's eq. (17): the state Jacobian of the drift alone.
+    held = build_linear_model(rates, hold_lever_arms=True)
+    _, jac_held, _ = (np.asarray(m) for m in held.jacobians(x0, u, p))
+    drift = _finite_difference(lambda x: np.asarray(rates(x, 0 * u, p)).ravel(), x0)
+    np.testing.assert_allclose(jac_held, drift, rtol=1e-5, atol=1e-5)
+    assert held.state_pattern.sum() < mpc.model.state_pattern.sum()
+
+
+def _pyramid_violation(problem: MpcProblem, inputs: np.ndarray) -> float:
+    rows = np.einsum("kij,kj->ki", problem.constraint_matrix, inputs)
+    return float(
+        max((rows - problem.constraint_upper).max(), (problem.constraint_lower - rows).max())
+    )
+
+
+def test_qp_is_built_once_and_updates_only_values(
+    skate_mpc: LinearMpc, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    reference = skate_mpc.reference
+    first = skate_mpc.problem(0.0, reference.states[0])
+    push = next(i for i, contacts in enumerate(reference.schedule) if Contact.GROUND in contacts)
+    t_push = reference.times[push] - 0.1  # the horizon spans swing, push and their change
+    second = skate_mpc.problem(t_push, reference.sample(t_push, 1, MPC_STEP).states[0])
+    assert first.constraint_upper.tolist() != second.constraint_upper.tolist()
+
+    qp = skate_mpc.build_qp(first, eps_abs=1e-6, eps_rel=1e-6, time_limit=1.0)
+    indices, indptr = qp.pattern
+    nnz = qp.nnz
+    _, a_first = qp.matrices(first)
+    _, a_second = qp.matrices(second)
+    for matrix in (a_first, a_second):
+        assert matrix.nnz == nnz
+        np.testing.assert_array_equal(matrix.indices, indices)
+        np.testing.assert_array_equal(matrix.indptr, indptr)
+    assert not np.allclose(a_first.data, a_second.data)
+
+    def no_second_setup(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the QP was set up again")
+
+    monkeypatch.setattr(qp._solver, "setup", no_second_setup)
+    for problem in (first, second):
+        plan = qp.solve(problem)
+        assert plan.status == "solved" and not plan.fallback
+        x, u = plan.states, plan.inputs
+        np.testing.assert_allclose(x[0], problem.initial_state, atol=1e-6)
+        residual = x[1:] - np.einsum("kij,kj->ki", problem.A, x[:-1])
+        residual -= np.einsum("kij,kj->ki", problem.B, u) + problem.c
+        assert np.abs(residual).max() < 1e-4
+        assert _pyramid_violation(problem, u) < 1e-4
+        assert np.all(u >= problem.input_lower - 1e-4) and np.all(u <= problem.input_upper + 1e-4)
+    assert qp.nnz == nnz and qp.failures == 0
+    # The second horizon holds a swinging foot: its force is zero, and the pushing foot on
+    # the ground has a force.
+    window = reference.sample(t_push, qp.horizon, MPC_STEP)
+    pusher = window.contacts[-1].index(Contact.GROUND)
+    swinging = [k for k, c in enumerate(window.contacts) if c[pusher] is Contact.SWING]
+    assert swinging and len(swinging) < qp.horizon
+    forces = plan.inputs[:, reference.force_index[pusher]]
+    assert np.abs(forces[swinging]).max() < 1e-4
+    assert forces[-1, 2] > 1.0
+
+
+def _closed_loop(mpc: LinearMpc, x0: np.ndarray, substeps: int = 10) -> dict[str, np.ndarray]:
+    """The MPC's first input held for one step on ``rates`` (RK4), over the reference."""
+    rates, reference, dt = mpc.model.rates, mpc.reference, mpc.settings.dt
+    steps = round(reference.duration / dt)
+    h = dt / substeps
+    x = x0.copy()
+    states, times = [], []
+    for i in range(steps):
+        t = i * dt
+        plan = mpc.update(t, x)
+        u, p = plan.first_input, reference.sample(t, 1, dt).parameters[0]
+
+        def f(y: np.ndarray, u: np.ndarray = u, p: np.ndarray = p) -> np.ndarray:
+            return np.asarray(rates(y, u, p)).ravel()
+
+        for _ in range(substeps):
+            k1 = f(x)
+            k2 = f(x + h / 2 * k1)
+            k3 = f(x + h / 2 * k2)
+            k4 = f(x + h * k3)
+            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        states.append(x.copy())
+        times.append(t + dt)
+    assert mpc.qp is not None
+    solve_times = np.array([r.solve_time for r in mpc.qp.history])
+    print(
+        f"\n{reference.name}: {steps} solves, median {np.median(solve_times) * 1e3:.2f} ms, "
+        f"p99 {np.percentile(solve_times, 99) * 1e3:.2f} ms, failures {mpc.qp.failures}"
+    )
+    track = reference.sample(0.0, steps, dt).states[1:]
+    return {"states": np.array(states), "reference": track, "times": np.array(times)}
+
+
+def _errors(run: dict[str, np.ndarray], names: tuple[str, ...]) -> dict[str, float]:
+    gap = np.abs(run["states"] - run["reference"]).max(axis=0)
+    errors = dict(zip(names, gap.tolist(), strict=True))
+    print("largest tracking errors: " + ", ".join(f"{n} {e:.3g}" for n, e in errors.items()))
+    return errors
+
+
+def _perturbed(mpc: LinearMpc, offsets: dict[str, float]) -> np.ndarray:
+    names = mpc.reference.state_names
+    x0 = mpc.reference.states[0].copy()
+    for name, offset in offsets.items():
+        x0[names.index(name)] += offset
+    return x0
+
+
+def test_closed_loop_skateboard_push() -> None:
+    mpc = LinearMpc.from_library("cyberdog2", "skateboard", "accelerate", 0.3)
+    offsets = {"com_y": 0.01, "com_z": -0.005, "trunk_roll": 0.02, "trunk_pitch": -0.02}
+    run = _closed_loop(mpc, _perturbed(mpc, {**offsets, "board_roll": 0.01}))
+    names = mpc.reference.state_names
+    errors = _errors(run, names)
+    speed = run["states"][-1, names.index("board_v")]
+    assert abs(speed - 0.3) < 0.03, speed
+    assert mpc.qp is not None and mpc.qp.failures == 0
+    bounds = {
+        "com_x": 0.03,
+        "com_y": 0.03,
+        "com_z": 0.01,
+        "trunk_roll": 0.03,
+        "trunk_pitch": 0.03,
+        "trunk_yaw": 0.02,
+        "vx": 0.03,
+        "vy": 0.1,
+        "board_v": 0.03,
+        "board_roll": 0.05,
+        "board_yaw": 0.02,
+    }
+    for name, bound in bounds.items():
+        assert errors[name] < bound, (name, errors[name])
+    joints = [errors[n] for n in names if n.startswith("q_")]
+    assert max(joints) < 0.02
+
+
+def test_closed_loop_hovershoes_lean() -> None:
+    mpc = LinearMpc.from_library("cassie", "hovershoes", "accelerate", 0.5)
+    offsets = {"com_x": 0.01, "com_y": 0.01, "pelvis_roll": 0.02, "pelvis_pitch": -0.02}
+    run = _closed_loop(mpc, _perturbed(mpc, offsets))
+    names = mpc.reference.state_names
+    errors = _errors(run, names)
+    for shoe in ("left_v", "right_v"):
+        speed = run["states"][-1, names.index(shoe)]
+        assert abs(speed - 0.5) < 0.05, (shoe, speed)
+    assert mpc.qp is not None and mpc.qp.failures == 0
+    bounds = {
+        "com_x": 0.08,
+        "com_y": 0.03,
+        "com_z": 0.02,
+        "pelvis_roll": 0.03,
+        "pelvis_pitch": 0.03,
+        "pelvis_yaw": 0.02,
+        "vx": 0.05,
+        "left_v": 0.1,
+        "right_v": 0.1,
+        "left_theta": 0.05,
+        "right_theta": 0.05,
+    }
+    for name, bound in bounds.items():
+        assert errors[name] < bound, (name, errors[name])
+
+
+def test_infeasible_update_falls_back_to_the_shifted_plan(skate_mpc: LinearMpc) -> None:
+    reference = skate_mpc.reference
+    good = skate_mpc.problem(0.0, reference.states[0])
+    qp = skate_mpc.build_qp(good)
+    previous = qp.solve(good)
+    assert not previous.fallback and qp.failures == 0
+    # Contradictory: a standing foot must push down harder than its pyramid allows.
+    lower = good.input_lower.copy()
+    lower[:, reference.force_index[0][2]] = (
+        10.0 * load_mpc_pair("cyberdog2", "skateboard").max_force
+    )
+    bad = dataclasses.replace(good, input_lower=lower)
+    plan = qp.solve(bad)
+    assert plan.fallback and plan.status != "solved"
+    assert qp.failures == 1
+    np.testing.assert_allclose(plan.states[:-1], previous.states[1:])
+    np.testing.assert_allclose(plan.first_input, previous.inputs[1])
+    assert qp.history[-1].fallback and qp.history[-1].status == plan.status
+    # Failing again shifts again; a good problem recovers.
+    again = qp.solve(bad)
+    np.testing.assert_allclose(again.first_input, previous.inputs[2])
+    assert qp.failures == 2
+    assert not qp.solve(good).fallback
+
+
+def test_problem_is_checked(skate_mpc: LinearMpc) -> None:
+    good = skate_mpc.problem(0.0, skate_mpc.reference.states[0])
+    with pytest.raises(ValueError, match="B has shape"):
+        dataclasses.replace(good, B=good.B[:, :-1, :])
+    with pytest.raises(ValueError, match="above"):
+        dataclasses.replace(good, input_lower=good.input_upper + 1.0)
+    with pytest.raises(ValueError, match="NaN"):
+        dataclasses.replace(good, initial_state=np.full(good.nx, np.nan))
+    with pytest.raises(ValueError, match="non-negative"):
+        dataclasses.replace(good, state_weights=-good.state_weights)
+
+
+def test_reference_schedule_and_steady_riding(skate_mpc: LinearMpc) -> None:
+    reference = skate_mpc.reference
+    assert reference.contact_names == ("FL_contact", "FR_contact", "RL_contact", "RR_contact")
+    assert reference.force_index.tolist()[2] == [6, 7, 8]
+    kinds = {c for contacts in reference.schedule for c in contacts}
+    assert kinds == {Contact.BOARD, Contact.GROUND, Contact.SWING}
+    # Parameters (the deck flags) agree with the schedule.
+    on_deck = np.array([[c is Contact.BOARD for c in cs] for cs in reference.schedule])
+    np.testing.assert_array_equal(on_deck, reference.parameters > 0.5)
+    # After the end: the board rolls on at its final speed, the rest is held.
+    window = reference.sample(reference.duration + 1.0, 3, MPC_STEP)
+    names = reference.state_names
+    x = window.states[:, names.index("board_x")]
+    speed = reference.states[-1, names.index("board_v")]
+    np.testing.assert_allclose(np.diff(x), speed * MPC_STEP, rtol=0.05)
+    np.testing.assert_allclose(
+        window.states[:, names.index("com_z")], reference.states[-1, 2], atol=1e-3
+    )
+    np.testing.assert_allclose(window.inputs, np.tile(reference.inputs[-1], (3, 1)))
+
+
+def test_reference_blends_neighbouring_entries() -> None:
+    reference = select_reference("cassie", "hovershoes", "accelerate", 0.75)
+    low = select_reference("cassie", "hovershoes", "accelerate", 0.5)
+    high = select_reference("cassie", "hovershoes", "accelerate", 1.0)
+    assert "+" in reference.name and reference.target == pytest.approx(0.75)
+    assert low.duration < reference.duration < high.duration
+    names = reference.state_names
+    assert reference.states[-1, names.index("left_v")] == pytest.approx(0.75, abs=1e-6)
+    assert [p.mode for p in reference.phases] == [p.mode for p in low.phases]
+    # The skateboard's entries differ in their pushes: the nearest is taken.
+    nearest = select_reference("cyberdog2", "skateboard", "accelerate", 0.45)
+    assert nearest.name == "accelerate-0.50"
+    beyond = select_reference("cyberdog2", "skateboard", "accelerate", 5.0)
+    assert beyond.name == "accelerate-1.00"
+
+
+def test_bad_library_raises_config_error(tmp_path: Path) -> None:
+    folder = tmp_path / "cyberdog2-skateboard"
+    shutil.copytree(library_folder("cyberdog2", "skateboard"), folder)
+    with pytest.raises(ConfigError, match="no 'stop' entries"):
+        select_reference("cyberdog2", "skateboard", "stop", 0.3, folder=folder)
+    entry = folder / "accelerate-0.30.npz"
+    entry.write_bytes(entry.read_bytes()[:100])
+    with pytest.raises(ConfigError, match="accelerate-0.30.npz"):
+        select_reference("cyberdog2", "skateboard", "accelerate", 0.3, folder=folder)
+    entry.unlink()
+    with pytest.raises(ConfigError, match="accelerate-0.30.npz"):
+        select_reference("cyberdog2", "skateboard", "accelerate", 0.3, folder=folder)
+    manifest = folder / "manifest.json"
+    raw = json.loads(manifest.read_text())
+    raw["entries"] = [e for e in raw["entries"] if e["name"] == "accelerate-0.50"]
+    raw["entries"][0]["metadata"]["phases"][0]["contacts"] = ["board", "flying"]
+    manifest.write_text(json.dumps(raw))
+    with pytest.raises(ConfigError, match="accelerate-0.50.npz: metadata phase 0"):
+        select_reference("cyberdog2", "skateboard", "accelerate", 0.5, folder=folder)
+    manifest.unlink()
+    with pytest.raises(ConfigError, match="manifest.json"):
+        select_reference("cyberdog2", "skateboard", "accelerate", 0.3, folder=folder)
+    with pytest.raises(UnknownNameError):
+        load_mpc_pair("cassie", "skateboard")
+
+
+def test_retarget_keeps_the_qp() -> None:
+    mpc = LinearMpc.from_library("cassie", "segway", "accelerate", 0.5)
+    x0 = mpc.reference.states[0]
+    assert not mpc.update(0.0, x0).fallback
+    qp = mpc.qp
+    mpc.retarget("stop", 1.0)
+    assert mpc.reference.name == "stop-1.00"
+    plan = mpc.update(0.0, mpc.reference.states[0])
+    assert mpc.qp is qp and not plan.fallback
+
+
+def test_settings_are_checked() -> None:
+    with pytest.raises(ConfigError, match="horizon"):
+        MpcSettings(horizon=0)
+    assert MpcSettings().dt == pytest.approx(1.0 / 30.0)
+    assert ROWS_PER_CONTACT == 5
