@@ -1,0 +1,311 @@
+"""Constraints of the whole-body QP, each a block of rows :math:`l \\le C z \\le u`.
+
+Every constraint keeps the same rows (and the same non-zero pattern) at every tick, so the
+QP's matrices keep a fixed sparsity pattern: an equality has :math:`l = u`, and a row that
+does not apply this tick (the contact rows of a foot in the air) gets
+:math:`l = -\\infty, u = +\\infty`. :meth:`Constraint.compute_qp_constraint` returns the
+block as a :class:`LinearConstraint` :math:`(C, l, u)`; an inequality
+:math:`G z \\le h` is :math:`(G, -\\infty, h)` and an equality :math:`A z = b` is
+:math:`(A, b, b)`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.wbc.contacts import ContactSet
+from ridempc.wbc.layout import DecisionLayout
+from ridempc.wbc.model import ModelTerms
+from ridempc.wbc.targets import WbcTargets
+
+__all__ = [
+    "ClosedChainConstraint",
+    "Constraint",
+    "ContactAccelerationConstraint",
+    "DynamicsConstraint",
+    "FrictionPyramidConstraint",
+    "LinearConstraint",
+    "RigidSpringConstraint",
+    "TorqueLimitConstraint",
+]
+
+Array = NDArray[np.float64]
+Index = NDArray[np.int64]
+INF: float = np.inf
+
+
+class LinearConstraint(NamedTuple):
+    """Rows :math:`l \\le C z \\le u`.
+
+    Attributes:
+        matrix: :math:`C`, shape (rows, n_z).
+        lower: :math:`l` (``-inf`` where unbounded).
+        upper: :math:`u` (``+inf`` where unbounded).
+    """
+
+    matrix: Array
+    lower: Array
+    upper: Array
+
+
+class Constraint(ABC):
+    """A block of QP rows with a fixed shape.
+
+    Args:
+        layout: The decision vector's layout.
+
+    Attributes:
+        rows: Number of rows, the same at every tick.
+    """
+
+    rows: int
+
+    def __init__(self, layout: DecisionLayout) -> None:
+        self.layout = layout
+
+    @abstractmethod
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        """The block's :math:`(C, l, u)`."""
+
+
+class DynamicsConstraint(Constraint):
+    """Floating-base dynamics, all :math:`n_v` rows (the six base rows have no torque):
+
+    .. math:: M \\ddot q + h = S^\\top \\tau + J_c^\\top f + J_{loop}^\\top \\lambda + \\tau_p
+
+    [N, N m], with :math:`S^\\top` placing each motor's torque on its joint, :math:`J_c` the
+    contact sites' stacked Jacobians, and :math:`\\tau_p` the passive torques (springs and
+    damping, see :mod:`ridempc.wbc.model`): a passive joint takes no motor torque.
+
+    The rows of ``free_rows`` are left free (infinite bounds): a spring taken as rigid
+    (:class:`RigidSpringConstraint`) exerts whatever torque holds it, so its row says nothing.
+
+    Args:
+        layout: The decision vector's layout.
+        motor_v: Velocity index of each motor's joint.
+        free_rows: Velocity indices whose rows are left free.
+    """
+
+    def __init__(
+        self, layout: DecisionLayout, motor_v: Index, free_rows: Index | None = None
+    ) -> None:
+        super().__init__(layout)
+        self.rows = layout.nv
+        self._template = np.zeros((layout.nv, layout.size))
+        self._template[motor_v, layout.torque.start + np.arange(layout.n_motors)] = -1.0  # -S^T
+        self._free = np.zeros(layout.nv, dtype=bool)
+        if free_rows is not None:
+            self._free[free_rows] = True
+        self._any_free = bool(self._free.any())
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        layout = self.layout
+        matrix = self._template.copy()
+        matrix[:, layout.acceleration] = terms.mass_matrix
+        matrix[:, layout.force] = -terms.sites.jacobian.reshape(-1, layout.nv).T
+        matrix[:, layout.loop_force] = -terms.loop_jacobian.T
+        b = terms.passive - terms.bias
+        if not self._any_free:
+            return LinearConstraint(matrix, b, b.copy())
+        return LinearConstraint(matrix, np.where(self._free, -INF, b), np.where(self._free, INF, b))
+
+
+class RigidSpringConstraint(Constraint):
+    """Leaf springs taken as rigid: each spring joint :math:`s` only has its motion damped,
+
+    .. math:: \\ddot q_s = -k_d \\dot q_s \\quad [rad/s^2],
+
+    and its dynamics row is left free (:class:`DynamicsConstraint`), so the QP neither reads
+    the spring's torque from its measured deflection :math:`-k (q_s - q_{ref})` nor lets the
+    spring swing.
+
+    Cassie stands in simulation this way and not with passive springs: MuJoCo's achilles-rod
+    ``connect`` is soft (``solref`` 0.005 s) and stretches by about 2 mm under the standing
+    load, so the heel-spring deflection that the estimator solves from the rigid closure is
+    about twice the true one (-0.053 against -0.026 rad once settled, some 33 N m of heel
+    torque that is not there). Taking that torque as known, the QP answers it with a pelvis
+    pitch acceleration that grows (-50 to -390 rad/s^2 over 0.12 s) until OSQP fails, 0.14 s
+    after the start.
+
+    Args:
+        layout: The decision vector's layout.
+        spring_v: Velocity index of each spring joint.
+        damping: :math:`k_d` [1/s].
+    """
+
+    def __init__(self, layout: DecisionLayout, spring_v: Index, damping: float) -> None:
+        super().__init__(layout)
+        self.rows = len(spring_v)
+        self._spring_v = np.asarray(spring_v, dtype=np.int64)
+        self._matrix = np.zeros((self.rows, layout.size))
+        self._matrix[np.arange(self.rows), self._spring_v] = 1.0
+        self.damping = damping
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        b = -self.damping * terms.v[self._spring_v]
+        return LinearConstraint(self._matrix.copy(), b, b)
+
+
+class ClosedChainConstraint(Constraint):
+    """Closed chains hold at the acceleration level: :math:`\\ddot r = 0`,
+
+    .. math:: J_{loop} \\ddot q + \\dot J_{loop} v = 0 \\quad [m/s^2].
+
+    Args:
+        layout: The decision vector's layout.
+    """
+
+    def __init__(self, layout: DecisionLayout) -> None:
+        super().__init__(layout)
+        self.rows = 3 * layout.n_loops
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        matrix = np.zeros((self.rows, self.layout.size))
+        matrix[:, self.layout.acceleration] = terms.loop_jacobian
+        b = -terms.loop_drift
+        return LinearConstraint(matrix, b, b)
+
+
+class ContactAccelerationConstraint(Constraint):
+    """Sites in contact move with their support: :math:`E_s (J_s \\ddot q + \\dot J_s v) =
+    E_s a_s^*` [m/s^2], :math:`a_s^*` from :mod:`ridempc.wbc.contacts`.
+
+    A foot's first site is held in all three directions (:math:`E_s = I`). A line foot's
+    second site is held only across the line joining the two,
+    :math:`E_s = B_s R_{WS}^\\top` with :math:`B_s` two unit rows orthogonal to the line in
+    the site's frame (``WholeBodyModel.line_basis``): along the line the two points of a
+    rigid foot cannot move apart, so that row would repeat the others (and contradict them
+    by the rounding of :math:`\\dot J v`). The foot keeps its roll about the line, as a
+    capsule does.
+
+    Args:
+        layout: The decision vector's layout.
+        site_partner: Per site, the first site of its line foot if it is the second, else -1.
+        line_basis: Per site, :math:`B_s` (used for the second sites), shape (sites, 2, 3).
+    """
+
+    def __init__(self, layout: DecisionLayout, site_partner: Index, line_basis: Array) -> None:
+        super().__init__(layout)
+        first = np.asarray(site_partner) < 0
+        self._first = np.flatnonzero(first)
+        self._second = np.flatnonzero(~first)
+        self._basis = np.asarray(line_basis)[self._second]
+        # rows: three per first site, then two per second site
+        self._split = 3 * self._first.size
+        self.rows = self._split + 2 * self._second.size
+        self._row_site = np.concatenate([np.repeat(self._first, 3), np.repeat(self._second, 2)])
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        nv, split = self.layout.nv, self._split
+        sites = terms.sites
+        first, second = self._first, self._second
+        wanted = contacts.acceleration - sites.drift
+        matrix = np.zeros((self.rows, self.layout.size))
+        matrix[:split, :nv] = sites.jacobian[first].reshape(-1, nv)
+        b = np.empty(self.rows)
+        b[:split] = wanted[first].ravel()
+        if second.size:
+            basis = self._basis @ terms.site_rotation[second].transpose(0, 2, 1)  # E_s, world
+            matrix[split:, :nv] = (basis @ sites.jacobian[second]).reshape(-1, nv)
+            b[split:] = (basis @ wanted[second][:, :, None]).ravel()
+        active = contacts.active[self._row_site]
+        return LinearConstraint(matrix, np.where(active, b, -INF), np.where(active, b, INF))
+
+
+class FrictionPyramidConstraint(Constraint):
+    """Unilateral contact inside a friction pyramid, in each site's support frame:
+
+    .. math:: |t_k^\\top f_s| \\le \\mu\\, n^\\top f_s \\ (k = 1, 2), \\qquad
+              f_{min} \\le n^\\top f_s \\le f_{max}
+
+    [N] for a site in contact (the pyramid implies :math:`n^\\top f_s \\ge 0`, so with
+    :math:`f_{min} = 0` the normal row only bounds from above). A site in the air gets no
+    force, :math:`f_s = 0`, as three equalities on the same rows,
+    :math:`(t_1 - \\mu n)^\\top f_s = (t_2 - \\mu n)^\\top f_s = n^\\top f_s = 0`, the other two
+    left free: pinning all five at zero would make a degenerate active set (five rows on
+    three unknowns), on which OSQP's polishing fails.
+
+    Args:
+        layout: The decision vector's layout.
+        friction: :math:`\\mu` [-].
+        min_normal_force: :math:`f_{min}` [N].
+        max_normal_force: :math:`f_{max}` [N].
+    """
+
+    def __init__(
+        self,
+        layout: DecisionLayout,
+        friction: float,
+        min_normal_force: float,
+        max_normal_force: float,
+    ) -> None:
+        super().__init__(layout)
+        self.friction = friction
+        self.min_normal_force = min_normal_force
+        self.max_normal_force = max_normal_force
+        self.rows = 5 * layout.n_sites
+        sites = np.arange(layout.n_sites)
+        # (site, row, component) -> row 5 s + row, column of f_s's component
+        self._row_index = np.broadcast_to(
+            (5 * sites[:, None] + np.arange(5))[:, :, None], (layout.n_sites, 5, 3)
+        ).ravel()
+        self._column_index = np.broadcast_to(
+            (layout.force.start + 3 * sites[:, None] + np.arange(3))[:, None, :],
+            (layout.n_sites, 5, 3),
+        ).ravel()
+        lowest = min_normal_force if min_normal_force > 0.0 else -INF
+        self._contact_lower = np.tile([-INF, -INF, -INF, -INF, lowest], layout.n_sites)
+        self._contact_upper = np.tile([0.0, 0.0, 0.0, 0.0, max_normal_force], layout.n_sites)
+        self._swing_lower = np.tile([0.0, -INF, 0.0, -INF, 0.0], layout.n_sites)
+        self._swing_upper = np.tile([0.0, INF, 0.0, INF, 0.0], layout.n_sites)
+        mu = friction
+        # rows t1 - mu n, -t1 - mu n, t2 - mu n, -t2 - mu n, n of the frame (t1, t2, n)
+        self._pyramid = np.array(
+            [[1.0, 0.0, -mu], [-1.0, 0.0, -mu], [0.0, 1.0, -mu], [0.0, -1.0, -mu], [0.0, 0.0, 1.0]]
+        )
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        rows = self._pyramid @ contacts.frame  # (sites, 5, 3)
+        matrix = np.zeros((self.rows, self.layout.size))
+        matrix[self._row_index, self._column_index] = rows.ravel()
+        active = np.repeat(contacts.active, 5)
+        lower = np.where(active, self._contact_lower, self._swing_lower)
+        upper = np.where(active, self._contact_upper, self._swing_upper)
+        return LinearConstraint(matrix, lower, upper)
+
+
+class TorqueLimitConstraint(Constraint):
+    """Motor torque limits: :math:`-\\tau_{max} \\le \\tau \\le \\tau_{max}` [N m].
+
+    Args:
+        layout: The decision vector's layout.
+        limits: :math:`\\tau_{max}` per motor [N m], actuator order.
+    """
+
+    def __init__(self, layout: DecisionLayout, limits: Array) -> None:
+        super().__init__(layout)
+        self.rows = layout.n_motors
+        self._matrix = np.zeros((self.rows, layout.size))
+        self._matrix[:, layout.torque] = np.eye(layout.n_motors)
+        self._limits = np.asarray(limits, dtype=float)
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        return LinearConstraint(self._matrix.copy(), -self._limits, self._limits.copy())

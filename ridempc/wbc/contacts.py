@@ -1,0 +1,119 @@
+"""Where each contact site stands this tick: its support's normal, tangents and motion.
+
+A site is *active* when its foot is planned in contact. It then stays on its support:
+
+- on the ground: normal :math:`n = e_z`, tangents :math:`e_x, e_y`, and the point does not
+  accelerate, :math:`a^* = 0`;
+- on a board platform (its foot listed in a :class:`~ridempc.estimation.BoardEstimate`):
+  the platform's axes :math:`R_{WP} = R_z(\\psi) R_y(\\theta) R_x(\\phi)` from the estimate's
+  yaw, pitch and roll give :math:`n = R_{WP} e_z` (the tilted deck's normal) and the
+  tangents :math:`R_{WP} e_x, R_{WP} e_y`; the point moves with the platform,
+
+  .. math:: a^* = a_P + \\omega_P \\times (\\omega_P \\times r), \\qquad r = p - o_P
+
+  [m/s^2], with :math:`a_P` the platform origin's acceleration (the targets', zero if
+  unknown), :math:`\\omega_P = (0, 0, \\dot\\psi)` [rad/s] the estimate's yaw rate (the
+  estimator does not report roll and pitch rates) and :math:`o_P` its origin [m]. The
+  tangential (Euler) term :math:`\\dot\\omega_P \\times r` is left out: it is not estimated.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.estimation.state import BoardEstimate
+from ridempc.wbc.model import ModelTerms
+
+__all__ = ["ContactSet", "build_contact_set", "platform_rotation"]
+
+Array = NDArray[np.float64]
+Index = NDArray[np.int64]
+_AXES = np.eye(3)
+
+
+def platform_rotation(board: BoardEstimate) -> Array:
+    """:math:`R_{WP} = R_z(\\psi) R_y(\\theta) R_x(\\phi)` of a board estimate."""
+    cy, sy = math.cos(board.yaw), math.sin(board.yaw)
+    cp, sp = math.cos(board.pitch), math.sin(board.pitch)
+    cr, sr = math.cos(board.roll), math.sin(board.roll)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+@dataclass(frozen=True)
+class ContactSet:
+    """The contact sites at one tick, layout order.
+
+    Attributes:
+        active: Whether each site is in contact (its foot planned in contact).
+        frame: Each site's support axes as rows :math:`(t_1, t_2, n)` [-], shape
+            (sites, 3, 3): two tangents and the normal.
+        acceleration: Wanted acceleration of each active site :math:`a^*` [m/s^2],
+            shape (sites, 3).
+    """
+
+    active: NDArray[np.bool_]
+    frame: Array
+    acceleration: Array
+
+    @property
+    def normal(self) -> Array:
+        """Support normal at each site, shape (sites, 3)."""
+        return self.frame[:, 2]
+
+    @property
+    def tangents(self) -> Array:
+        """Two support tangents at each site, shape (sites, 2, 3)."""
+        return self.frame[:, :2]
+
+    @classmethod
+    def on_ground(cls, active: NDArray[np.bool_]) -> ContactSet:
+        """Every site on flat, still ground."""
+        n = len(active)
+        return cls(np.asarray(active, dtype=bool), np.tile(_AXES, (n, 1, 1)), np.zeros((n, 3)))
+
+
+def build_contact_set(
+    terms: ModelTerms,
+    site_foot: Index,
+    foot_names: Sequence[str],
+    contact: NDArray[np.bool_],
+    boards: Sequence[BoardEstimate] = (),
+    board_acceleration: Sequence[Array] = (),
+) -> ContactSet:
+    """Normals, tangents and wanted accelerations of the contact sites.
+
+    Args:
+        terms: The model at this tick (site positions).
+        site_foot: Foot index of each site.
+        foot_names: The feet's names.
+        contact: Planned contact per foot.
+        boards: The estimator's board platforms (empty on the ground).
+        board_acceleration: Acceleration of each platform's origin [m/s^2] (zero if missing).
+    """
+    active = np.asarray(contact, dtype=bool)[site_foot]
+    contacts = ContactSet.on_ground(active)
+    for k, board in enumerate(boards):
+        feet = [i for i, name in enumerate(foot_names) if name in board.feet]
+        sites = np.flatnonzero(np.isin(site_foot, feet))
+        if sites.size == 0:
+            continue
+        contacts.frame[sites] = platform_rotation(board).T
+        origin_acceleration = (
+            np.asarray(board_acceleration[k]) if k < len(board_acceleration) else np.zeros(3)
+        )
+        lever = terms.sites.position[sites] - board.position
+        centripetal = -(board.yaw_rate**2) * lever  # omega x (omega x r), omega along z
+        centripetal[:, 2] = 0.0
+        contacts.acceleration[sites] = origin_acceleration + centripetal
+    return contacts

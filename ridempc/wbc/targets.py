@@ -1,0 +1,145 @@
+"""What the whole-body controller is asked for (:class:`WbcTargets`) and what it returns
+(:class:`WbcOutput`).
+
+Frames: everything is in the world frame W (z up) unless said otherwise; quaternions are
+(w, x, y, z), base to world, as in :class:`~ridempc.estimation.EstimatedState`. Per-foot
+arrays follow the robot's ``foot_bodies`` order (``EstimatedState.foot_names``); per-motor
+arrays follow the actuator order (``Robot.motors``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.errors import ConfigError
+
+__all__ = ["WbcOutput", "WbcTargets"]
+
+Array = NDArray[np.float64]
+
+
+def _zeros3() -> Array:
+    return np.zeros(3)
+
+
+def _check_shape(name: str, value: object, shape: tuple[int, ...]) -> None:
+    array = np.asarray(value)
+    if array.shape != shape or not np.all(np.isfinite(array)):
+        raise ConfigError(
+            f"WBC targets: field '{name}': expected finite values of shape {shape}, "
+            f"got shape {array.shape}"
+        )
+
+
+@dataclass(frozen=True)
+class WbcTargets:
+    """The MPC's references for one 500 Hz tick.
+
+    Attributes:
+        position: Centre of mass (or base origin, as the controller is built) [m].
+        orientation: Base orientation, unit quaternion (w, x, y, z) (normalised here).
+        contact: Planned contact of each foot (True: it stands and may push).
+        forces: The support's force on each foot [N], shape (feet, 3); ignored for feet in
+            the air.
+        velocity: Velocity of ``position`` [m/s].
+        acceleration: Feedforward acceleration of ``position`` [m/s^2].
+        angular_velocity: Base angular velocity [rad/s] (world axes).
+        angular_acceleration: Feedforward base angular acceleration [rad/s^2] (world axes).
+        swing_position: Target of each foot's point (the mean of its contact sites) [m],
+            shape (feet, 3), used for the feet not in contact (push-off); None: no swing task.
+        swing_velocity: Its velocity [m/s] (zero if None).
+        swing_acceleration: Its feedforward acceleration [m/s^2] (zero if None).
+        posture: Nominal motor joint angles [rad], actuator order; None: the controller's.
+        board_acceleration: Per board estimate in ``EstimatedState.boards``, the platform
+            origin's acceleration [m/s^2]; empty or missing entries mean zero.
+    """
+
+    position: Array
+    orientation: Array
+    contact: NDArray[np.bool_]
+    forces: Array
+    velocity: Array = field(default_factory=_zeros3)
+    acceleration: Array = field(default_factory=_zeros3)
+    angular_velocity: Array = field(default_factory=_zeros3)
+    angular_acceleration: Array = field(default_factory=_zeros3)
+    swing_position: Array | None = None
+    swing_velocity: Array | None = None
+    swing_acceleration: Array | None = None
+    posture: Array | None = None
+    board_acceleration: tuple[Array, ...] = ()
+
+    def __post_init__(self) -> None:
+        for name in (
+            "position",
+            "velocity",
+            "acceleration",
+            "angular_velocity",
+            "angular_acceleration",
+        ):
+            _check_shape(name, getattr(self, name), (3,))
+            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
+        _check_shape("orientation", self.orientation, (4,))
+        norm = float(np.linalg.norm(self.orientation))
+        if abs(norm - 1.0) > 1e-3:
+            raise ConfigError(
+                f"WBC targets: field 'orientation': not a unit quaternion (norm {norm:.6f})"
+            )
+        object.__setattr__(self, "orientation", np.asarray(self.orientation, dtype=float) / norm)
+        feet = len(np.asarray(self.contact))
+        _check_shape("forces", self.forces, (feet, 3))
+        for name in ("swing_position", "swing_velocity", "swing_acceleration"):
+            value = getattr(self, name)
+            if value is not None:
+                _check_shape(name, value, (feet, 3))
+        for k, acceleration in enumerate(self.board_acceleration):
+            _check_shape(f"board_acceleration[{k}]", acceleration, (3,))
+
+    @property
+    def n_feet(self) -> int:
+        return len(np.asarray(self.contact))
+
+
+@dataclass(frozen=True)
+class WbcOutput:
+    """The whole-body QP's answer for one tick.
+
+    The joint targets integrate the solution's acceleration over one tick :math:`\\Delta t`:
+    :math:`q^* = q + v \\Delta t + \\tfrac12 \\ddot q \\Delta t^2`,
+    :math:`\\dot q^* = v + \\ddot q \\Delta t`, for the low-level PD
+    :math:`\\tau_{motor} = \\tau + k_p (q^* - q) + k_d (\\dot q^* - \\dot q)`.
+
+    Attributes:
+        torque: Motor torques [N m], actuator order (joint side).
+        position: Motor joint position targets :math:`q^*` [rad].
+        velocity: Motor joint velocity targets :math:`\\dot q^*` [rad/s].
+        acceleration: The solution's :math:`\\ddot q` (Pinocchio coordinates).
+        forces: The support's force on each foot [N], shape (feet, 3).
+        site_forces: On each contact site [N], shape (sites, 3).
+        loop_forces: Closed-chain constraint forces :math:`\\lambda` [N].
+        status: OSQP's status (``solved`` or ``solved inaccurate``).
+        iterations: ADMM iterations.
+        model_ms: Pinocchio model update [ms].
+        build_ms: Building the QP's matrices (tasks and constraints) [ms].
+        solve_ms: OSQP update, factorisation and solve [ms].
+    """
+
+    torque: Array
+    position: Array
+    velocity: Array
+    acceleration: Array
+    forces: Array
+    site_forces: Array
+    loop_forces: Array
+    status: str
+    iterations: int
+    model_ms: float
+    build_ms: float
+    solve_ms: float
+
+    @property
+    def total_ms(self) -> float:
+        """Model update, QP build and QP solve [ms]."""
+        return self.model_ms + self.build_ms + self.solve_ms
