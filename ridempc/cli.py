@@ -66,6 +66,17 @@ def _parser() -> argparse.ArgumentParser:
     compare.add_argument("--duration", type=float, default=None, help="override duration [s]")
     compare.add_argument("--out", type=Path, required=True, help="output folder")
 
+    bench = commands.add_parser(
+        "bench", help="MPC and WBC solve times on recorded problems, against other QP solvers"
+    )
+    bench.add_argument(
+        "--pairs", default=None, help="comma-separated robot-board pairs (default: all)"
+    )
+    bench.add_argument(
+        "--seconds", type=float, default=2.0, help="simulated seconds recorded per pair"
+    )
+    bench.add_argument("--json", type=Path, default=None, help="also write the results here")
+
     board = commands.add_parser("board", help="board tools")
     board_commands = board.add_subparsers(dest="board_command", required=True)
     identify = board_commands.add_parser(
@@ -130,6 +141,16 @@ def _compare(args: argparse.Namespace) -> int:
     print(f"results in {args.out}")
     failed = any(s["status"] == "failed" for r in rows for s in r.summaries)
     return EXIT_FAILED if failed else 0
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from ridempc.bench import bench
+
+    if not args.seconds > 0.0:
+        raise ConfigError(f"--seconds {args.seconds}: must be positive")
+    pairs = [p.strip() for p in args.pairs.split(",")] if args.pairs else None
+    bench(pairs, seconds=args.seconds, json_path=args.json)
+    return 0
 
 
 def _list() -> int:
@@ -213,6 +234,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _library(args)
         if args.command == "compare":
             return _compare(args)
+        if args.command == "bench":
+            return _bench(args)
         return _sim(args)
     except (UnknownNameError, ConfigError) as exc:
         print(f"ridempc: error: {exc}", file=sys.stderr)

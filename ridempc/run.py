@@ -198,6 +198,7 @@ def ride(request: RideRequest) -> dict[str, Any]:
         or (controller is not None and controller.uses_ground_truth),
         "rider_mass_kg": round(scene.rider_mass, 4),
         **run_metrics(result, scenario, robot),
+        **(controller.summary() if controller is not None else {}),
         "files": files,
     }
     atomic_write_json(out / "summary.json", summary)

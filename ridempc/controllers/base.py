@@ -9,7 +9,7 @@ A controller runs at its own rate (a divisor of the physics rate), reads only a
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
@@ -46,6 +46,11 @@ class Controller(ABC):
 
     def diagnostics(self) -> dict[str, float]:
         """Scalars to log at this tick (solve times, modes, ...)."""
+        return {}
+
+    def summary(self) -> dict[str, Any]:
+        """Figures of the whole ride for ``summary.json`` (solve times, fallbacks, a safe
+        hold and why); JSON-serialisable. None by default."""
         return {}
 
     def estimate(self) -> EstimatedState | None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ridempc.controllers.base import Controller
+from ridempc.controllers.mpc import make_mpc_rider
 from ridempc.controllers.pd import make_pd_baseline
 from ridempc.controllers.stand import StandController
 from ridempc.errors import ConfigError, UnknownNameError
@@ -19,6 +20,7 @@ DEAD_WEIGHT = "dead-weight"  # the controller of a dead weight: none at all
 CONTROLLERS: dict[str, Callable[[Robot, str], Controller]] = {
     "stand": StandController,
     "pd": make_pd_baseline,
+    "mpc": make_mpc_rider,
 }
 
 

@@ -1,0 +1,291 @@
+"""``ridempc bench``: MPC and WBC solve times on recorded problems, and other QP solvers.
+
+For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIRS`):
+
+1. **Record.** The ``mpc`` rider rides the pair's ``stand-still`` scenario for
+   ``seconds`` of simulated time (seed 0): every MPC problem (30 Hz) and every WBC input
+   (estimate and targets, 500 Hz) is kept, and the ride's wall time gives the closed-loop
+   **real-time factor** (simulated over wall time; above 1 is faster than real time). A
+   ride that falls early still gives its problems up to the fall; the table says how many.
+2. **MPC.** The recorded problems are solved again in order by a fresh
+   :class:`~ridempc.mpc.qp.MpcQP` (OSQP, built once, updated in place, warm-started):
+   median and p99 of the update-and-solve time [ms].
+3. **WBC.** The recorded ticks are solved again by a fresh
+   :class:`~ridempc.wbc.WholeBodyController`: median and p99 of model update + QP [ms].
+4. **Other solvers.** The same MPC QPs, :math:`\\min \\tfrac12 z^\\top P z` s.t.
+   :math:`l \\le A z \\le u`, are handed to each other backend available here: the
+   qpsolvers backends (``proxqp``, ``daqp``, ... with equality rows :math:`l = u` as
+   equalities) and HPIPM through CasADi's ``conic`` interface; each is timed from a cold
+   start per problem (no warm start), and its objective compared with OSQP's.
+
+Times are wall-clock on this machine and vary with its load; the targets are an MPC p99 of
+at most 5 ms and a WBC p99 of at most 1 ms.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ridempc.io import atomic_write_json
+
+__all__ = ["PairBench", "bench", "bench_table"]
+
+OTHER_QP_SOLVERS: tuple[str, ...] = ("proxqp", "daqp", "piqp", "clarabel")
+
+
+@dataclass
+class PairBench:
+    """One pair's figures (times in ms)."""
+
+    pair: str
+    mpc_problems: int = 0
+    wbc_ticks: int = 0
+    simulated_s: float = 0.0
+    real_time_factor: float = float("nan")
+    mpc_solve_median_ms: float = float("nan")
+    mpc_solve_p99_ms: float = float("nan")
+    wbc_solve_median_ms: float = float("nan")
+    wbc_solve_p99_ms: float = float("nan")
+    ride_status: str = ""
+    solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+def _stats(values: Sequence[float]) -> tuple[float, float]:
+    if not values:
+        return float("nan"), float("nan")
+    ms = 1e3 * np.asarray(values)
+    return float(np.median(ms)), float(np.percentile(ms, 99))
+
+
+def _record(robot_name: str, board_name: str, seconds: float) -> tuple[Any, list, list, Any]:
+    from ridempc.boards import load_board
+    from ridempc.mpc.rider import MpcRider
+    from ridempc.robots import load_robot
+    from ridempc.scenarios import resolve_scenario
+    from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+    from ridempc.sim.scene import build_scene
+    from ridempc.sim.simulation import Simulation
+
+    problems: list = []
+    wbc_inputs: list = []
+
+    class Recording(MpcRider):
+        def _mpc_tick(self, estimate: Any, command: Any, now: float) -> None:
+            super()._mpc_tick(estimate, command, now)
+            problems.append(self._last_problem)
+
+    robot = load_robot(robot_name)
+    rider = Recording(robot, board_name)
+    solve = rider.wbc.solve
+
+    def recording_solve(state: Any, targets: Any) -> Any:
+        wbc_inputs.append((state, targets))
+        return solve(state, targets)
+
+    rider.wbc.solve = recording_solve  # type: ignore[method-assign]
+    scenario = resolve_scenario("stand-still", board_name).with_duration(seconds)
+    scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=load_board(board_name))
+    started = time.perf_counter()
+    result = Simulation(scene, rider, scenario).run()
+    wall = time.perf_counter() - started
+    return result, problems, wbc_inputs, (rider, wall)
+
+
+def _as_qpsolvers(p: sp.csc_matrix, a: sp.csc_matrix, lower: np.ndarray, upper: np.ndarray) -> Any:
+    import qpsolvers
+
+    equal = np.isclose(lower, upper)
+    a = a.tocsr()
+    rows_up = ~equal & np.isfinite(upper)
+    rows_lo = ~equal & np.isfinite(lower)
+    g = sp.vstack([a[rows_up], -a[rows_lo]]).tocsc()
+    h = np.concatenate([upper[rows_up], -lower[rows_lo]])
+    return qpsolvers.Problem(
+        P=p, q=np.zeros(p.shape[0]), G=g, h=h, A=a[equal].tocsc(), b=lower[equal]
+    )
+
+
+def _objective(p: sp.csc_matrix, z: np.ndarray) -> float:
+    return float(0.5 * z @ (p @ z))
+
+
+def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
+    import qpsolvers
+
+    out: dict[str, dict[str, Any]] = {}
+    data = []
+    for problem in problems:
+        p, a = qp.matrices(problem)
+        _, lower, upper = qp._data(problem)
+        data.append((p, a, lower, upper))
+    reference = []
+    for p, a, lower, upper in data:
+        qp_osqp = _as_qpsolvers(p, a, lower, upper)
+        solution = qpsolvers.solve_problem(qp_osqp, solver="osqp", eps_abs=1e-6, eps_rel=1e-6)
+        found = solution.found and solution.x is not None
+        reference.append(_objective(p, solution.x) if found else float("nan"))  # type: ignore[arg-type]
+    for name in (*OTHER_QP_SOLVERS, "hpipm (casadi)"):
+        if name != "hpipm (casadi)" and name not in qpsolvers.available_solvers:
+            continue
+        times, gaps, failures = [], [], 0
+        try:
+            for (p, a, lower, upper), best in zip(data, reference, strict=True):
+                if name == "hpipm (casadi)":
+                    z, seconds = _solve_hpipm(p, a, lower, upper)
+                else:
+                    problem = _as_qpsolvers(p, a, lower, upper)
+                    started = time.perf_counter()
+                    solution = qpsolvers.solve_problem(problem, solver=name)
+                    seconds = time.perf_counter() - started
+                    z = solution.x if solution.found else None
+                times.append(seconds)
+                if z is None:
+                    failures += 1
+                else:
+                    gaps.append(abs(_objective(p, z) - best) / max(abs(best), 1e-9))
+            median, p99 = _stats(times)
+            out[name] = {
+                "solve_median_ms": median,
+                "solve_p99_ms": p99,
+                "failures": failures,
+                "objective_gap_max": float(np.max(gaps)) if gaps else None,
+            }
+        except Exception as exc:  # a backend's own error: reported, not fatal
+            message = " ".join(f"{type(exc).__name__}: {exc}".split())
+            out[name] = {"error": message[:160]}
+    return out
+
+
+def _solve_hpipm(
+    p: sp.csc_matrix, a: sp.csc_matrix, lower: np.ndarray, upper: np.ndarray
+) -> tuple[np.ndarray | None, float]:
+    import casadi as ca
+
+    hs = ca.DM(p)
+    as_ = ca.DM(a)
+    solver = ca.conic(
+        "hpipm",
+        "hpipm",
+        {"h": hs.sparsity(), "a": as_.sparsity()},
+        {"print_problem": False, "hpipm": {"warm_start": False}, "error_on_fail": False},
+    )
+    n = p.shape[0]
+    started = time.perf_counter()
+    result = solver(h=hs, g=np.zeros(n), a=as_, lba=lower, uba=upper, lbx=-np.inf, ubx=np.inf)
+    seconds = time.perf_counter() - started
+    ok = solver.stats().get("success", False)
+    return (np.asarray(result["x"]).ravel() if ok else None), seconds
+
+
+def bench_pair(robot: str, board: str, seconds: float = 2.0) -> PairBench:
+    """Record one pair's ride and time its problems (see the module docstring)."""
+    from ridempc.mpc.controller import LinearMpc
+    from ridempc.wbc import WholeBodyController
+
+    out = PairBench(pair=f"{robot}-{board}")
+    result, problems, wbc_inputs, (rider, wall) = _record(robot, board, seconds)
+    out.ride_status = "fell" if result.fell else result.status
+    out.simulated_s = float(result.sim_time)
+    out.real_time_factor = float(result.sim_time / wall) if wall > 0 else float("nan")
+    out.mpc_problems, out.wbc_ticks = len(problems), len(wbc_inputs)
+    if problems:
+        mpc = LinearMpc(rider.pair, rider.mpc.reference, rider.mpc.model, rider.mpc.settings)
+        qp = mpc.build_qp(problems[0])
+        times = []
+        for problem in problems:
+            started = time.perf_counter()
+            qp.solve(problem)
+            times.append(time.perf_counter() - started)
+        out.mpc_solve_median_ms, out.mpc_solve_p99_ms = _stats(times)
+        out.solvers = _other_solvers(qp, problems)
+        out.solvers["osqp"] = {
+            "solve_median_ms": out.mpc_solve_median_ms,
+            "solve_p99_ms": out.mpc_solve_p99_ms,
+            "failures": int(qp.failures),
+            "objective_gap_max": 0.0,
+            "warm_started": True,
+        }
+    if wbc_inputs:
+        wbc = WholeBodyController(rider.robot, pinocchio=rider.pinocchio)
+        times = []
+        for state, targets in wbc_inputs:
+            started = time.perf_counter()
+            wbc.solve(state, targets)
+            times.append(time.perf_counter() - started)
+        out.wbc_solve_median_ms, out.wbc_solve_p99_ms = _stats(times)
+    return out
+
+
+def bench_table(rows: Sequence[PairBench]) -> str:
+    """The results as a Markdown table, then one table of the MPC QP solvers."""
+
+    def f(v: float) -> str:
+        return "-" if v != v else f"{v:.2f}"
+
+    lines = [
+        "| pair | ride | MPC problems | MPC median / p99 [ms] | WBC ticks | "
+        "WBC median / p99 [ms] | real-time factor |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r.pair} | {r.ride_status} ({r.simulated_s:.2f} s) | {r.mpc_problems} | "
+            f"{f(r.mpc_solve_median_ms)} / {f(r.mpc_solve_p99_ms)} | {r.wbc_ticks} | "
+            f"{f(r.wbc_solve_median_ms)} / {f(r.wbc_solve_p99_ms)} | {f(r.real_time_factor)} |"
+        )
+    lines += ["", "| pair | MPC QP solver | median / p99 [ms] | failures | max objective gap |"]
+    lines.append("|---|---|---|---|---|")
+    for r in rows:
+        for name, s in r.solvers.items():
+            if "error" in s:
+                lines.append(f"| {r.pair} | {name} | {s['error']} | - | - |")
+                continue
+            gap = s["objective_gap_max"]
+            lines.append(
+                f"| {r.pair} | {name} | {f(s['solve_median_ms'])} / {f(s['solve_p99_ms'])} | "
+                f"{s['failures']} | {'-' if gap is None else f'{gap:.1e}'} |"
+            )
+    return "\n".join(lines)
+
+
+def bench(
+    pairs: Sequence[str] | None = None, seconds: float = 2.0, json_path: Path | None = None
+) -> list[PairBench]:
+    """Benchmark ``pairs`` (default: every pair with an MPC), print and optionally save.
+
+    Raises:
+        UnknownNameError: A pair without an MPC.
+    """
+    from dataclasses import asdict
+
+    from ridempc.errors import UnknownNameError
+    from ridempc.mpc.pairs import MPC_PAIRS
+
+    names = list(pairs) if pairs else list(MPC_PAIRS)
+    for name in names:
+        if name not in MPC_PAIRS:
+            raise UnknownNameError("robot-board pair for the MPC", name, MPC_PAIRS)
+    rows = []
+    for name in names:
+        robot, board = name.split("-", 1)
+        print(f"  {name}: recording {seconds:g} s of stand-still ...", flush=True)
+        rows.append(bench_pair(robot, board, seconds))
+    print(bench_table(rows))
+    if json_path is not None:
+
+        def clean(value: Any) -> Any:
+            if isinstance(value, float) and value != value:
+                return None
+            if isinstance(value, dict):
+                return {k: clean(v) for k, v in value.items()}
+            return value
+
+        atomic_write_json(json_path, {r.pair: clean(asdict(r)) for r in rows})
+    return rows

@@ -1,0 +1,171 @@
+"""Which library trajectory the MPC tracks for the command, and the command laid over it.
+
+The motion library holds manoeuvres from rest or between steady speeds (``accelerate``,
+``stop``, ``turn``); a ride is a sequence of them:
+
+- **hold**: before any speed is commanded, the first ``accelerate`` entry's initial state
+  (standing on the board at rest) is held: the reference time stays before its start;
+- **accelerate** to the commanded speed :math:`v^*` [m/s] (the nearest entry, or a blend of
+  the two neighbouring ones where the library allows it), started *at the phase where the
+  reference's speed equals the board's estimated speed*, so a step from 0.5 to 1.0 m/s picks
+  up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily;
+- **stop** when the command returns to zero, where the library has ``stop`` entries (the
+  skateboard has none: it coasts on, four-leg balancing).
+
+Targets beyond the library's range are clamped to it. On top of the trajectory the command
+sets the deck roll (the skateboard's ``board_roll`` and ``board_roll_rate``, held over the
+horizon at the commanded rate) when it commands one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.errors import ConfigError
+from ridempc.library.store import library_folder
+from ridempc.mpc.problem import MpcProblem
+from ridempc.scenarios.scenario import Command
+
+__all__ = ["HOLD", "MOVING", "Manoeuvre", "ManoeuvreSelector"]
+
+Array = NDArray[np.float64]
+MOVING: float = 0.05  # [m/s] a commanded speed below this is rest
+HOLD: str = "hold"
+
+
+@dataclass(frozen=True)
+class Manoeuvre:
+    """A library trajectory and when it started.
+
+    Attributes:
+        kind: ``hold``, ``accelerate`` or ``stop``.
+        target: The entry's target speed [m/s].
+        start: Simulation time at which the reference's time is zero [s].
+    """
+
+    kind: str
+    target: float
+    start: float = 0.0
+
+    @property
+    def library_kind(self) -> str:
+        return "accelerate" if self.kind == HOLD else self.kind
+
+    def started(self, now: float) -> Manoeuvre:
+        return self if self.kind != HOLD else replace(self, start=now)
+
+    def reference_time(self, now: float) -> float:
+        """The reference's time [s]; a hold stays before the trajectory's start."""
+        return -1.0 if self.kind == HOLD else now - self.start
+
+    def same_goal(self, other: Manoeuvre) -> bool:
+        return self.kind == other.kind and math.isclose(self.target, other.target, abs_tol=1e-6)
+
+
+class ManoeuvreSelector:
+    """Picks the manoeuvre for a command (see the module docstring).
+
+    Args:
+        robot: Robot name.
+        board: Board name.
+
+    Raises:
+        ConfigError: The pair's library is missing or has no ``accelerate`` entries.
+    """
+
+    def __init__(self, robot: str, board: str) -> None:
+        from ridempc.library.store import read_manifest
+
+        folder = library_folder(robot, board)
+        manifest = read_manifest(folder)
+        self.targets: dict[str, tuple[float, ...]] = {}
+        for entry in manifest.entries:
+            self.targets.setdefault(entry.kind, ())
+            self.targets[entry.kind] = tuple(sorted({*self.targets[entry.kind], entry.target}))
+        if "accelerate" not in self.targets:
+            raise ConfigError(f"{folder / 'manifest.json'}: no 'accelerate' entries")
+        names = _state_names(folder)
+        self.prefixes = tuple(n[: -len("x")] for n in names if n.endswith("_x") and n != "com_x")
+        bases = [
+            n[: -len("roll")]
+            for n in names
+            if n.endswith("_roll") and not n.startswith(self.prefixes)
+        ]
+        if len(bases) != 1:
+            raise ConfigError(f"{folder}: cannot tell the base's roll among {names}")
+        self.base_prefix = bases[0]
+
+    def initial(self) -> Manoeuvre:
+        return Manoeuvre(HOLD, self.targets["accelerate"][0])
+
+    def _clamped(self, kind: str, target: float) -> float:
+        targets = self.targets[kind]
+        return float(min(max(target, targets[0]), targets[-1]))
+
+    def select(self, command: Command, current: Manoeuvre, now: float, speed: float) -> Manoeuvre:
+        """The manoeuvre for ``command`` at ``now`` [s], the board at ``speed`` [m/s].
+
+        A new manoeuvre's ``start`` is provisional (``now``); the rider moves it to match
+        the reference's speed phase (:meth:`phase_start`).
+        """
+        wanted = command.velocity
+        if wanted < MOVING:
+            if current.kind in (HOLD, "stop") or "stop" not in self.targets:
+                return current
+            return Manoeuvre("stop", self._clamped("stop", max(speed, current.target)), now)
+        goal = Manoeuvre("accelerate", self._clamped("accelerate", wanted), now)
+        if current.kind == "accelerate" and current.same_goal(goal):
+            return current
+        return goal
+
+    @staticmethod
+    def phase_start(times: Array, speeds: Array, speed: float, now: float, kind: str) -> float:
+        """The start time that puts ``now`` at the reference's first time where its speed
+        reaches ``speed`` (rising for ``accelerate``, falling for ``stop``)."""
+        if kind == "accelerate":
+            reached = np.nonzero(speeds >= speed)[0]
+        else:
+            reached = np.nonzero(speeds <= speed)[0]
+        t_match = float(times[reached[0]]) if reached.size else 0.0
+        return now - t_match
+
+    def board_pose(self, names: dict[str, int], state: Array) -> tuple[float, float, float]:
+        """The first platform's (x, y, heading) in a reference state."""
+        prefix = self.prefixes[0]
+        heading = names.get(f"{prefix}yaw", names.get(f"{prefix}psi"))
+        if heading is None:
+            raise ConfigError(f"no heading state for platform '{prefix}'")
+        return (
+            float(state[names[f"{prefix}x"]]),
+            float(state[names[f"{prefix}y"]]),
+            float(state[heading]),
+        )
+
+    @staticmethod
+    def with_command(
+        problem: MpcProblem, names: dict[str, int], command: Command, roll_rate: float
+    ) -> MpcProblem:
+        """The problem with the commanded deck roll laid over the reference (if it has one)."""
+        if "board_roll" not in names or (command.roll == 0.0 and roll_rate == 0.0):
+            return problem
+        states = problem.state_reference.copy()
+        k = np.arange(states.shape[0])
+        states[:, names["board_roll"]] = command.roll + roll_rate * k * problem.dt
+        if "board_roll_rate" in names:
+            states[:, names["board_roll_rate"]] = roll_rate
+        return replace(problem, state_reference=states)
+
+
+def _state_names(folder: object) -> list[str]:
+    from pathlib import Path
+
+    from ridempc.library.store import load_entry, read_manifest
+
+    path = Path(str(folder))
+    manifest = read_manifest(path)
+    entry = load_entry(path, manifest.entries[0])
+    return [str(n) for n in entry.arrays["state_names"]]

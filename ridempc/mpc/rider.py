@@ -1,0 +1,309 @@
+"""``mpc``: the skateboard paper's pipeline (section V) riding any pair with an MPC library.
+
+Every 2 ms (500 Hz) the rider
+
+1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
+   board from its own feet);
+2. every 15th tick (30 Hz), maps the estimate into the library frame
+   (:class:`~ridempc.mpc.state_map.StateMap`) and solves the linear MPC
+   (:class:`~ridempc.mpc.controller.LinearMpc`) on the manoeuvre the command asks for
+   (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
+   trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
+3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
+   over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
+   the Z-Y-X angles, the first input's contact forces (summed per foot), and, for a foot
+   the schedule lifts, a swing target; and solves the 500 Hz whole-body QP
+   (:class:`~ridempc.wbc.WholeBodyController`);
+4. sends the QP's torques as feedforward with its joint targets to the motor PD.
+
+**Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
+fallback, counted); if the estimate is not finite, the WBC fails or anything raises, the
+rider holds its joints where they are with the robot's default gains from then on, and its
+``summary()`` says why and when.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.controllers.base import Controller
+from ridempc.errors import RidempcError
+from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.manoeuvre import Manoeuvre, ManoeuvreSelector
+from ridempc.mpc.pairs import load_mpc_pair
+from ridempc.mpc.plan import Plan
+from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.state_map import StateMap
+from ridempc.robots.pinocchio_model import build_pinocchio_robot
+from ridempc.robots.robot import Robot
+from ridempc.scenarios.scenario import Command
+from ridempc.sim.motors import MotorCommand
+from ridempc.sim.sensors import SensorPacket
+from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
+
+__all__ = ["MpcRider"]
+
+Array = NDArray[np.float64]
+MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
+
+
+def _quaternion_zyx(roll: float, pitch: float, yaw: float) -> Array:
+    """(w, x, y, z) of :math:`R_z(\\psi) R_y(\\vartheta) R_x(\\phi)`."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return np.array(
+        [
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        ]
+    )
+
+
+def _platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
+    """Feet per platform: one each when the board has a platform per foot, else all on one."""
+    feet = robot.params.foot_bodies
+    if platforms == len(feet):
+        return tuple((foot,) for foot in feet)
+    return (feet,)
+
+
+class MpcRider(Controller):
+    """MPC at 30 Hz over the robot and its board, whole-body QP at 500 Hz.
+
+    Args:
+        robot: The rider.
+        board: The board's name; the pair needs an MPC library.
+        settings: MPC settings.
+
+    Raises:
+        UnknownNameError: No MPC for this robot-board pair.
+        ConfigError: Its library is missing or corrupt.
+    """
+
+    rate_hz = 500.0
+
+    def __init__(self, robot: Robot, board: str, settings: MpcSettings | None = None) -> None:
+        super().__init__(robot, board)
+        from ridempc.boards import load_board
+
+        self.pair = load_mpc_pair(robot.name, board)
+        loaded = load_board(board)
+        n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
+        self.platform_feet = _platform_feet(robot, n_platforms)
+        self.estimator = StateEstimator(robot, platforms=self.platform_feet)
+        self.pinocchio = build_pinocchio_robot(robot)
+        self.selector = ManoeuvreSelector(robot.name, board)
+        first = self.selector.initial()
+        self.mpc = LinearMpc.from_library(
+            robot.name, board, first.library_kind, first.target, settings
+        )
+        self.manoeuvre: Manoeuvre = first
+        reference = self.mpc.reference
+        self.map = StateMap(self.pinocchio, reference.state_names, self.selector.prefixes)
+        self.wbc = WholeBodyController(robot, pinocchio=self.pinocchio)
+        self.kp = np.array([m.kp for m in robot.motors])
+        self.kd = np.array([m.kd for m in robot.motors])
+        self.names = {name: i for i, name in enumerate(reference.state_names)}
+        self._contact_foot = self._contacts_to_feet(reference.contact_names)
+        self._tick = 0
+        self._plan: Plan | None = None
+        self._last_problem: MpcProblem | None = None
+        self._plan_time = 0.0
+        self._command_roll: tuple[float, float] | None = None
+        self._hold: MotorCommand | None = None
+        self._hold_reason: str | None = None
+        self._hold_time: float | None = None
+        self._mpc_ms: list[float] = []
+        self._wbc_ms: list[float] = []
+        self._diagnostics: dict[str, float] = {}
+
+    def _contacts_to_feet(self, contacts: tuple[str, ...]) -> list[int]:
+        """The foot (``foot_bodies`` index) each library contact belongs to."""
+        model = self.robot.mj_model
+        feet = list(self.robot.params.foot_bodies)
+        out = []
+        for contact in contacts:
+            site = model.site(contact)
+            body = model.body(int(site.bodyid[0])).name
+            out.append(feet.index(body))
+        return out
+
+    # ------------------------------------------------------------------ loop
+
+    def reset(self, sensors: SensorPacket) -> None:
+        self.estimator.reset(sensors)
+        self.map.reset()
+        self._tick = 0
+        self._plan = None
+        estimate = self.estimator.state
+        if estimate is not None:
+            self._anchor(estimate, sensors.time)
+
+    def _anchor(self, estimate: EstimatedState, now: float) -> None:
+        self.manoeuvre = self.manoeuvre.started(now)
+        window = self.mpc.reference.sample(self.manoeuvre.reference_time(now), 0, 1.0)
+        pose = self.selector.board_pose(self.names, window.states[0])
+        self.map.anchor(estimate, pose)
+
+    def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
+        if self._hold is None:
+            n = len(self.robot.motors)
+            self._hold = MotorCommand.hold(self.robot.motors, np.array(sensors.joint_position[:n]))
+            self._hold_reason = reason
+            self._hold_time = sensors.time
+        return self._hold
+
+    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        if self._hold is not None:
+            self.estimator.update(sensors)
+            return self._hold
+        if self._tick == 0 and self.estimator.state is None:
+            self.reset(sensors)
+        else:
+            self.estimator.update(sensors)
+        estimate = self.estimator.state
+        if estimate is None or not (
+            np.all(np.isfinite(estimate.q)) and np.all(np.isfinite(estimate.v))
+        ):
+            return self._safe_hold(sensors, f"state estimate not finite at {sensors.time:.3f} s")
+        try:
+            if self._tick % MPC_DIVIDER == 0:
+                self._mpc_tick(estimate, command, sensors.time)
+            out = self._wbc_tick(estimate, sensors.time)
+        except RidempcError as exc:
+            return self._safe_hold(sensors, f"{type(exc).__name__} at {sensors.time:.3f} s: {exc}")
+        self._tick += 1
+        return out
+
+    def _mpc_tick(self, estimate: EstimatedState, command: Command, now: float) -> None:
+        speed = self._speed(estimate)
+        wanted = self.selector.select(command, self.manoeuvre, now, speed)
+        if wanted is not self.manoeuvre:
+            self.mpc.retarget(wanted.library_kind, wanted.target)
+            reference = self.mpc.reference
+            start = self.selector.phase_start(
+                reference.times, reference.states[:, self.names["vx"]], speed, now, wanted.kind
+            )
+            self.manoeuvre = replace(wanted, start=start)
+            self._anchor(estimate, now)
+        x0 = self.map.state(estimate)
+        t_ref = self.manoeuvre.reference_time(now)
+        started = time.perf_counter()
+        problem = self.mpc.problem(t_ref, x0)
+        problem = self.selector.with_command(
+            problem, self.names, command, self._roll_rate(command, now)
+        )
+        if self.mpc.qp is None:
+            self.mpc.qp = self.mpc.build_qp(problem)
+        self._last_problem = problem
+        plan = self.mpc.qp.solve(problem)
+        self._mpc_ms.append(1e3 * (time.perf_counter() - started))
+        if not np.all(np.isfinite(plan.states)):
+            raise RidempcError(f"MPC plan not finite (status {plan.status})")
+        self._plan, self._plan_time = plan, now
+        self._diagnostics.update(
+            mpc_ms=self._mpc_ms[-1],
+            mpc_fallback=float(plan.fallback),
+            mpc_iterations=float(plan.iterations),
+        )
+
+    def _roll_rate(self, command: Command, now: float) -> float:
+        previous = self._command_roll
+        self._command_roll = (now, command.roll)
+        if previous is None or now <= previous[0]:
+            return 0.0
+        return (command.roll - previous[1]) / (now - previous[0])
+
+    def _speed(self, estimate: EstimatedState) -> float:
+        if estimate.boards:
+            board = estimate.boards[0]
+            return float(
+                board.velocity[0] * math.cos(board.yaw) + board.velocity[1] * math.sin(board.yaw)
+            )
+        return float(np.linalg.norm(estimate.base_velocity[:2]))
+
+    def _wbc_tick(self, estimate: EstimatedState, now: float) -> MotorCommand:
+        plan = self._plan
+        assert plan is not None
+        n = self.names
+        share = min(max((now - self._plan_time) * 30.0, 0.0), 1.0)
+        x = (1.0 - share) * plan.states[0] + share * plan.states[1]
+        frame = self.map.frame
+        position = frame.point_to_world(np.array([x[n["com_x"]], x[n["com_y"]], x[n["com_z"]]]))
+        velocity = frame.vector_to_world(np.array([x[n["vx"]], x[n["vy"]], x[n["vz"]]]))
+        base = self.selector.base_prefix
+        roll, pitch, yaw = (x[n[f"{base}{a}"]] for a in ("roll", "pitch", "yaw"))
+        orientation = _quaternion_zyx(roll, pitch, yaw + frame.yaw)
+        rotation = _rotation_zyx(roll, pitch, yaw + frame.yaw)
+        omega_body = np.array([x[n["wx"]], x[n["wy"]], x[n["wz"]]])
+        index = self.mpc.reference.force_index
+        feet = len(self.robot.params.foot_bodies)
+        forces = np.zeros((feet, 3))
+        contact = np.zeros(feet, dtype=bool)
+        u = plan.first_input
+        for i, foot in enumerate(self._contact_foot):
+            f = frame.vector_to_world(u[index[i]])
+            forces[foot] += f
+            contact[foot] |= bool(f[2] > 1e-3)
+        if not contact.any():
+            contact[:] = True
+        targets = WbcTargets(
+            position=position,
+            orientation=orientation,
+            contact=contact,
+            forces=forces,
+            velocity=velocity,
+            angular_velocity=rotation @ omega_body,
+        )
+        out = self.wbc.solve(estimate, targets)
+        self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
+        self._diagnostics.update(wbc_ms=self._wbc_ms[-1])
+        return to_motor_command(out, self.kp, self.kd)
+
+    # ------------------------------------------------------------------ reports
+
+    def estimate(self) -> EstimatedState | None:
+        return self.estimator.state
+
+    def diagnostics(self) -> dict[str, float]:
+        return dict(self._diagnostics)
+
+    def summary(self) -> dict[str, Any]:
+        """Solve times, fallbacks and the safe hold, for ``summary.json``."""
+        out: dict[str, Any] = {}
+        for key, values in (("mpc_solve_ms", self._mpc_ms), ("wbc_solve_ms", self._wbc_ms)):
+            if values:
+                ms = np.asarray(values)
+                out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
+        qp = self.mpc.qp
+        out["mpc_solves"] = len(self._mpc_ms)
+        out["mpc_fallbacks"] = int(qp.failures) if qp is not None else 0
+        out["safe_hold"] = (
+            None
+            if self._hold_reason is None
+            else {"time_s": self._hold_time, "reason": self._hold_reason}
+        )
+        return out
+
+
+def _rotation_zyx(roll: float, pitch: float, yaw: float) -> Array:
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )

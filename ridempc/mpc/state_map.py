@@ -1,0 +1,235 @@
+"""From the state estimate to the MPC's state vector, and the plan back to the world.
+
+The MPC's state (the library's layout, named by ``state_names``) is built from the
+:class:`~ridempc.estimation.EstimatedState` alone, never from the simulator:
+
+- ``com_x, com_y, com_z`` [m], ``vx, vy, vz`` [m/s]: the whole robot's centre of mass and
+  its velocity, :math:`c(q)` and :math:`J_c(q)\\,v` from Pinocchio at the estimated
+  configuration;
+- ``*_roll, *_pitch, *_yaw`` [rad] (trunk or pelvis): Z-Y-X Euler angles of the estimated
+  base orientation, :math:`R = R_z(\\psi) R_y(\\vartheta) R_x(\\phi)`;
+- ``wx, wy, wz`` [rad/s]: the base angular velocity in the base frame;
+- ``q_<joint>`` [rad]: the encoders (through the estimator);
+- board states, by the suffix of their names, from the platform estimates of the rider's
+  feet (:class:`~ridempc.estimation.BoardEstimate`), one per platform in the order of
+  ``platform_prefixes``: ``x``, ``y`` [m] its origin, ``psi``/``yaw`` [rad] heading,
+  ``theta`` [rad] pitch (nose down positive), ``roll`` [rad], ``v``/``speed`` [m/s] forward
+  speed :math:`\\dot c \\cdot (\\cos\\psi, \\sin\\psi)`, and the rates ``theta_dot``,
+  ``theta_rate``, ``roll_rate``, ``psi_dot``, ``yaw_rate`` [rad/s], differentiated from the
+  angles through a first-order low-pass (``RATE_FILTER_HZ``).
+
+**Library frame.** The library's trajectories start at the origin, heading along x. The map
+keeps a planar transform :math:`(\\Delta\\psi, \\Delta p)` from the world to that frame,
+:math:`p_{lib} = R_z(-\\Delta\\psi)(p - \\Delta p)`, set by :meth:`StateMap.anchor` so that
+the estimated board pose lands on the reference's board pose at the moment a manoeuvre
+starts; positions, velocities, headings and forces are carried through it both ways.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ridempc.errors import ConfigError
+from ridempc.estimation import EstimatedState
+from ridempc.estimation.state import BoardEstimate
+from ridempc.robots.pinocchio_model import PinocchioRobot
+
+__all__ = ["RATE_FILTER_HZ", "PlanarFrame", "StateMap"]
+
+Array = NDArray[np.float64]
+RATE_FILTER_HZ: float = 15.0  # [Hz] on the differentiated platform angles
+
+
+def _euler_zyx(rotation: Array) -> tuple[float, float, float]:
+    """(roll, pitch, yaw) [rad] of :math:`R = R_z R_y R_x`."""
+    pitch = -math.asin(max(-1.0, min(1.0, float(rotation[2, 0]))))
+    roll = math.atan2(float(rotation[2, 1]), float(rotation[2, 2]))
+    yaw = math.atan2(float(rotation[1, 0]), float(rotation[0, 0]))
+    return roll, pitch, yaw
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@dataclass(frozen=True)
+class PlanarFrame:
+    """World to library frame: :math:`p_{lib} = R_z(-\\Delta\\psi)(p - \\Delta p)`.
+
+    Attributes:
+        yaw: :math:`\\Delta\\psi` [rad].
+        offset: :math:`\\Delta p` [m] (x, y).
+    """
+
+    yaw: float = 0.0
+    offset: tuple[float, float] = (0.0, 0.0)
+
+    def _rotation(self, sign: float) -> Array:
+        c, s = math.cos(self.yaw), math.sin(sign * self.yaw)
+        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+    def point_to_library(self, p: Array) -> Array:
+        shifted = np.asarray(p, dtype=float) - np.array([*self.offset, 0.0])
+        return self._rotation(-1.0) @ shifted
+
+    def vector_to_library(self, v: Array) -> Array:
+        return self._rotation(-1.0) @ np.asarray(v, dtype=float)
+
+    def point_to_world(self, p: Array) -> Array:
+        return self._rotation(1.0) @ np.asarray(p, dtype=float) + np.array([*self.offset, 0.0])
+
+    def vector_to_world(self, v: Array) -> Array:
+        return self._rotation(1.0) @ np.asarray(v, dtype=float)
+
+
+class _AngleRate:
+    """:math:`\\dot a` from samples of :math:`a`, low-passed at ``hz`` (first order)."""
+
+    def __init__(self, hz: float) -> None:
+        self.hz = hz
+        self.previous: tuple[float, float] | None = None
+        self.rate = 0.0
+
+    def __call__(self, time: float, angle: float) -> float:
+        if self.previous is not None and time > self.previous[0]:
+            dt = time - self.previous[0]
+            raw = _wrap(angle - self.previous[1]) / dt
+            alpha = 1.0 - math.exp(-2.0 * math.pi * self.hz * dt)
+            self.rate += alpha * (raw - self.rate)
+        self.previous = (time, angle)
+        return self.rate
+
+
+class StateMap:
+    """Builds the MPC's state vector from estimates (see the module docstring).
+
+    Args:
+        robot: The rider's Pinocchio model.
+        state_names: The pair's state layout.
+        platform_prefixes: The board-state prefix of each platform estimate, estimator
+            order (``("board_",)``, ``("left_", "right_")``, ``("segway_",)``).
+
+    Raises:
+        ConfigError: A state name the map cannot fill.
+    """
+
+    def __init__(
+        self,
+        robot: PinocchioRobot,
+        state_names: Sequence[str],
+        platform_prefixes: Sequence[str],
+    ) -> None:
+        self.robot = robot
+        self.data = robot.model.createData()
+        self.names = tuple(state_names)
+        self.prefixes = tuple(platform_prefixes)
+        self.frame = PlanarFrame()
+        self._rates: dict[str, _AngleRate] = {}
+        self._fill = [self._filler(name) for name in self.names]
+
+    def _filler(self, name: str) -> tuple[str, int | str]:
+        body = {"com_x": 0, "com_y": 1, "com_z": 2}
+        if name in body:
+            return ("com", body[name])
+        if name in ("vx", "vy", "vz"):
+            return ("com_velocity", "xyz".index(name[1]))
+        if name in ("wx", "wy", "wz"):
+            return ("omega", "xyz".index(name[1]))
+        for k, angle in enumerate(("roll", "pitch", "yaw")):
+            if name in (f"trunk_{angle}", f"pelvis_{angle}"):
+                return ("base_angle", k)
+        if name.startswith("q_"):
+            return ("joint", name[2:])
+        for k, prefix in enumerate(self.prefixes):
+            if name.startswith(prefix):
+                return ("board", f"{k}:{name[len(prefix) :]}")
+        raise ConfigError(f"MPC state map: cannot estimate state '{name}'")
+
+    def reset(self) -> None:
+        self.frame = PlanarFrame()
+        self._rates = {}
+
+    def _board_value(self, key: str, boards: tuple[BoardEstimate, ...], time: float) -> float:
+        index, field = key.split(":", 1)
+        k = int(index)
+        if k >= len(boards):
+            raise ConfigError(f"MPC state map: no estimate of platform {k}")
+        board = boards[k]
+        heading = board.yaw - self.frame.yaw
+        origin = self.frame.point_to_library(board.position)
+        if field == "x":
+            return float(origin[0])
+        if field == "y":
+            return float(origin[1])
+        if field in ("psi", "yaw"):
+            return heading
+        if field == "theta":
+            return board.pitch
+        if field == "roll":
+            return board.roll
+        if field in ("v", "speed"):
+            return float(
+                board.velocity[0] * math.cos(board.yaw) + board.velocity[1] * math.sin(board.yaw)
+            )
+        angle = {
+            "theta_dot": board.pitch,
+            "theta_rate": board.pitch,
+            "roll_rate": board.roll,
+            "psi_dot": board.yaw,
+            "yaw_rate": board.yaw,
+        }
+        if field in angle:
+            rate = self._rates.setdefault(key, _AngleRate(RATE_FILTER_HZ))
+            return rate(time, angle[field])
+        raise ConfigError(f"MPC state map: unknown board state '{field}'")
+
+    def state(self, estimate: EstimatedState) -> Array:
+        """:math:`x_0` in the library frame, the pair's layout."""
+        model, data = self.robot.model, self.data
+        com = pin.centerOfMass(model, data, estimate.q, estimate.v)
+        com_velocity = np.array(data.vcom[0])
+        rotation = estimate.rotation
+        roll, pitch, yaw = _euler_zyx(rotation)
+        angles = (roll, pitch, _wrap(yaw - self.frame.yaw))
+        com_lib = self.frame.point_to_library(com)
+        velocity_lib = self.frame.vector_to_library(com_velocity)
+        x = np.empty(len(self.names))
+        for i, (kind, key) in enumerate(self._fill):
+            if kind == "com":
+                x[i] = com_lib[int(key)]
+            elif kind == "com_velocity":
+                x[i] = velocity_lib[int(key)]
+            elif kind == "omega":
+                x[i] = estimate.base_angular_velocity[int(key)]
+            elif kind == "base_angle":
+                x[i] = angles[int(key)]
+            elif kind == "joint":
+                x[i] = estimate.joint_position[str(key)]
+            else:
+                x[i] = self._board_value(str(key), estimate.boards, estimate.time)
+        return x
+
+    def anchor(self, estimate: EstimatedState, board_pose: tuple[float, float, float]) -> None:
+        """Set the frame so that platform 0's estimate lands on ``board_pose`` (x, y, yaw) of
+        the reference."""
+        board = estimate.boards[0] if estimate.boards else None
+        if board is None:
+            rotation = estimate.rotation
+            yaw_world = math.atan2(float(rotation[1, 0]), float(rotation[0, 0]))
+            position = estimate.base_position
+        else:
+            yaw_world, position = board.yaw, board.position
+        x_ref, y_ref, yaw_ref = board_pose
+        dyaw = _wrap(yaw_world - yaw_ref)
+        c, s = math.cos(dyaw), math.sin(dyaw)
+        offset = (
+            float(position[0] - (c * x_ref - s * y_ref)),
+            float(position[1] - (s * x_ref + c * y_ref)),
+        )
+        self.frame = PlanarFrame(dyaw, offset)

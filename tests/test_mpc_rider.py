@@ -1,0 +1,69 @@
+"""``mpc``: the MPC/WBC rider in MuJoCo, a short ride, its safe hold and bad input."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from ridempc.boards import load_board
+from ridempc.cli import main
+from ridempc.mpc.rider import MpcRider
+from ridempc.robots import load_robot
+from ridempc.scenarios import resolve_scenario
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.scene import build_scene
+from ridempc.sim.simulation import Simulation
+from ridempc.wbc.qp import WbcFailed
+
+
+@pytest.fixture(scope="module")
+def dog():
+    return load_robot("cyberdog2")
+
+
+def _ride(dog, duration: float, rider: MpcRider | None = None):
+    scenario = resolve_scenario("stand-still", "skateboard").with_duration(duration)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    rider = rider or MpcRider(dog, "skateboard")
+    return Simulation(scene, rider, scenario).run(), rider
+
+
+def test_stands_on_the_skateboard(tmp_path) -> None:
+    out = tmp_path / "ride"
+    args = ["sim", "--robot", "cyberdog2", "--board", "skateboard", "--controller", "mpc"]
+    assert main([*args, "--duration", "2", "--no-plots", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "ok" and not summary["fell"]
+    assert abs(summary["base_height_drift"]) < 0.02
+    assert summary["velocity_rmse"] < 0.05
+    assert summary["safe_hold"] is None and summary["mpc_fallbacks"] == 0
+    assert summary["mpc_solves"] >= 60  # 30 Hz over 2 s
+    assert summary["mpc_solve_ms"]["median"] > 0.0 and summary["wbc_solve_ms"]["median"] > 0.0
+    assert summary["estimator_velocity_rmse"] < 0.05
+
+
+def test_a_failing_wbc_ends_in_a_safe_hold_that_the_summary_explains(dog) -> None:
+    rider = MpcRider(dog, "skateboard")
+    solve = rider.wbc.solve
+
+    def failing(state, targets):
+        if state.time > 0.5:
+            raise WbcFailed("primal infeasible", rider.wbc.last_problem)
+        return solve(state, targets)
+
+    rider.wbc.solve = failing
+    result, rider = _ride(dog, 1.0, rider)
+    assert result.status == "ok"  # held, not crashed
+    hold = rider.summary()["safe_hold"]
+    assert hold is not None and "WbcFailed" in hold["reason"]
+    assert 0.5 < hold["time_s"] < 0.51
+    joints = result.log["qpos"][:, 7:]
+    assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # holds its joints
+
+
+def test_a_pair_without_an_mpc_is_refused(tmp_path, capsys) -> None:
+    args = ["sim", "--robot", "cyberdog2", "--board", "none", "--controller", "mpc"]
+    assert main([*args, "--out", str(tmp_path / "x")]) == 2
+    assert "cyberdog2-none" in capsys.readouterr().err
