@@ -47,6 +47,7 @@ from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
+from ridempc.wbc.settings import WbcSettings
 
 __all__ = ["MpcRider"]
 
@@ -110,7 +111,13 @@ class MpcRider(Controller):
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.map = StateMap(self.pinocchio, reference.state_names, self.selector.prefixes)
-        self.wbc = WholeBodyController(robot, pinocchio=self.pinocchio)
+        # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
+        # the estimator's spring deflection (about twice the true one, through the soft
+        # achilles-rod constraint) drives the QP off (see the WBC's tests).
+        springs = "rigid" if np.any(self.pinocchio.spring_stiffness > 0.0) else "passive"
+        self.wbc = WholeBodyController(
+            robot, WbcSettings(springs=springs), pinocchio=self.pinocchio
+        )
         self.kp = np.array([m.kp for m in robot.motors])
         self.kd = np.array([m.kd for m in robot.motors])
         self.names = {name: i for i, name in enumerate(reference.state_names)}
