@@ -114,10 +114,9 @@ class MpcRider(Controller):
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
         # achilles-rod constraint) drives the QP off (see the WBC's tests).
-        springs = "rigid" if np.any(self.pinocchio.spring_stiffness > 0.0) else "passive"
-        self.wbc = WholeBodyController(
-            robot, WbcSettings(springs=springs), pinocchio=self.pinocchio
-        )
+        sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
+        settings_wbc = WbcSettings(springs="rigid") if sprung else WbcSettings()
+        self.wbc = WholeBodyController(robot, settings_wbc, pinocchio=self.pinocchio)
         self.kp = np.array([m.kp for m in robot.motors])
         self.kd = np.array([m.kd for m in robot.motors])
         self.names = {name: i for i, name in enumerate(reference.state_names)}
