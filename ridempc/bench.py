@@ -66,7 +66,7 @@ def _stats(values: Sequence[float]) -> tuple[float, float]:
     return float(np.median(ms)), float(np.percentile(ms, 99))
 
 
-def _record(robot_name: str, board_name: str, seconds: float) -> tuple[Any, list, list, Any]:
+def _record(robot_name: str, board_name: str, seconds: float) -> tuple[Any, list, list, Any, float]:
     from ridempc.boards import load_board
     from ridempc.mpc.rider import MpcRider
     from ridempc.robots import load_robot
@@ -97,7 +97,7 @@ def _record(robot_name: str, board_name: str, seconds: float) -> tuple[Any, list
     started = time.perf_counter()
     result = Simulation(scene, rider, scenario).run()
     wall = time.perf_counter() - started
-    return result, problems, wbc_inputs, (rider, wall)
+    return result, problems, wbc_inputs, rider, wall
 
 
 def _as_qpsolvers(p: sp.csc_matrix, a: sp.csc_matrix, lower: np.ndarray, upper: np.ndarray) -> Any:
@@ -125,7 +125,7 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
     data = []
     for problem in problems:
         p, a = qp.matrices(problem)
-        _, lower, upper = qp._data(problem)
+        lower, upper = qp.bounds(problem)
         data.append((p, a, lower, upper))
     reference = []
     for p, a, lower, upper in data:
@@ -192,7 +192,7 @@ def bench_pair(robot: str, board: str, seconds: float = 2.0) -> PairBench:
     from ridempc.wbc import WholeBodyController
 
     out = PairBench(pair=f"{robot}-{board}")
-    result, problems, wbc_inputs, (rider, wall) = _record(robot, board, seconds)
+    result, problems, wbc_inputs, rider, wall = _record(robot, board, seconds)
     out.ride_status = "fell" if result.fell else result.status
     out.simulated_s = float(result.sim_time)
     out.real_time_factor = float(result.sim_time / wall) if wall > 0 else float("nan")

@@ -25,7 +25,7 @@ def test_other_solvers_find_osqps_optimum(solver: str) -> None:
     plan = qp.solve(problem)
     assert plan.status == "solved"
     p, a = qp.matrices(problem)
-    _, lower, upper = qp._data(problem)
+    lower, upper = qp.bounds(problem)
     solution = qpsolvers.solve_problem(_as_qpsolvers(p, a, lower, upper), solver=solver)
     assert solution.found and solution.x is not None
     z = solution.x

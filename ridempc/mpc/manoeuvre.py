@@ -20,6 +20,7 @@ horizon at the commanded rate) when it commands one.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -30,7 +31,7 @@ from ridempc.library.store import library_folder
 from ridempc.mpc.problem import MpcProblem
 from ridempc.scenarios.scenario import Command
 
-__all__ = ["HOLD", "MOVING", "Manoeuvre", "ManoeuvreSelector"]
+__all__ = ["HOLD", "MOVING", "Manoeuvre", "ManoeuvreSelector", "StateLayout"]
 
 Array = NDArray[np.float64]
 MOVING: float = 0.05  # [m/s] a commanded speed below this is rest
@@ -66,6 +67,44 @@ class Manoeuvre:
         return self.kind == other.kind and math.isclose(self.target, other.target, abs_tol=1e-6)
 
 
+@dataclass(frozen=True)
+class StateLayout:
+    """Where the board and the base sit in a pair's state names.
+
+    Attributes:
+        prefixes: Each platform's state prefix, in state order (``board_``, ``left_`` and
+            ``right_``, ``segway_``): the names ending in ``_x`` other than ``com_x``.
+        base_prefix: The base's angle prefix (``trunk_``, ``pelvis_``): the one ``_roll``
+            that is not a platform's.
+        names: Index of each state name.
+    """
+
+    prefixes: tuple[str, ...]
+    base_prefix: str
+    names: dict[str, int]
+
+    @classmethod
+    def from_names(cls, state_names: Sequence[str]) -> StateLayout:
+        """Raises ConfigError: the names do not tell the base's roll."""
+        names = list(state_names)
+        prefixes = tuple(n[: -len("x")] for n in names if n.endswith("_x") and n != "com_x")
+        bases = [
+            n[: -len("roll")] for n in names if n.endswith("_roll") and not n.startswith(prefixes)
+        ]
+        if len(bases) != 1:
+            raise ConfigError(f"cannot tell the base's roll among the states {names}")
+        return cls(prefixes, bases[0], {n: i for i, n in enumerate(names)})
+
+    def board_pose(self, state: Array) -> tuple[float, float, float]:
+        """The first platform's (x, y, heading) in a state."""
+        prefix, names = self.prefixes[0], self.names
+        heading = names.get(f"{prefix}yaw", names.get(f"{prefix}psi"))
+        if heading is None:
+            raise ConfigError(f"no heading state for platform '{prefix}'")
+        x, y = state[names[f"{prefix}x"]], state[names[f"{prefix}y"]]
+        return float(x), float(y), float(state[heading])
+
+
 class ManoeuvreSelector:
     """Picks the manoeuvre for a command (see the module docstring).
 
@@ -88,16 +127,6 @@ class ManoeuvreSelector:
             self.targets[entry.kind] = tuple(sorted({*self.targets[entry.kind], entry.target}))
         if "accelerate" not in self.targets:
             raise ConfigError(f"{folder / 'manifest.json'}: no 'accelerate' entries")
-        names = _state_names(folder)
-        self.prefixes = tuple(n[: -len("x")] for n in names if n.endswith("_x") and n != "com_x")
-        bases = [
-            n[: -len("roll")]
-            for n in names
-            if n.endswith("_roll") and not n.startswith(self.prefixes)
-        ]
-        if len(bases) != 1:
-            raise ConfigError(f"{folder}: cannot tell the base's roll among {names}")
-        self.base_prefix = bases[0]
 
     def initial(self) -> Manoeuvre:
         return Manoeuvre(HOLD, self.targets["accelerate"][0])
@@ -133,18 +162,6 @@ class ManoeuvreSelector:
         t_match = float(times[reached[0]]) if reached.size else 0.0
         return now - t_match
 
-    def board_pose(self, names: dict[str, int], state: Array) -> tuple[float, float, float]:
-        """The first platform's (x, y, heading) in a reference state."""
-        prefix = self.prefixes[0]
-        heading = names.get(f"{prefix}yaw", names.get(f"{prefix}psi"))
-        if heading is None:
-            raise ConfigError(f"no heading state for platform '{prefix}'")
-        return (
-            float(state[names[f"{prefix}x"]]),
-            float(state[names[f"{prefix}y"]]),
-            float(state[heading]),
-        )
-
     @staticmethod
     def with_command(
         problem: MpcProblem, names: dict[str, int], command: Command, roll_rate: float
@@ -158,14 +175,3 @@ class ManoeuvreSelector:
         if "board_roll_rate" in names:
             states[:, names["board_roll_rate"]] = roll_rate
         return replace(problem, state_reference=states)
-
-
-def _state_names(folder: object) -> list[str]:
-    from pathlib import Path
-
-    from ridempc.library.store import load_entry, read_manifest
-
-    path = Path(str(folder))
-    manifest = read_manifest(path)
-    entry = load_entry(path, manifest.entries[0])
-    return [str(n) for n in entry.arrays["state_names"]]

@@ -344,6 +344,17 @@ class MpcQP:
         )
         return hessian, constraints
 
+    def bounds(self, problem: MpcProblem) -> tuple[Array, Array]:
+        """The scaled :math:`l, u` that ``problem`` writes into the QP, with :meth:`matrices`
+        the whole QP :math:`\\min \\tfrac12 z^\\top P z`, :math:`l \\le A_{qp} z \\le u`.
+
+        Raises:
+            ValueError: As :meth:`update`.
+        """
+        self._check_sizes(problem)
+        _, lower, upper = self._data(problem)
+        return lower, upper
+
     def update(self, problem: MpcProblem) -> None:
         """Write ``problem``'s values into the fixed pattern (no new setup).
 

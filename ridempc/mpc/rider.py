@@ -24,7 +24,6 @@ rider holds its joints where they are with the robot's default gains from then o
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import replace
 from typing import Any
@@ -35,17 +34,19 @@ from numpy.typing import NDArray
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.manoeuvre import Manoeuvre, ManoeuvreSelector
+from ridempc.mpc.manoeuvre import Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.state_map import StateMap
+from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
+from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
 from ridempc.wbc.settings import WbcSettings
 
@@ -53,21 +54,6 @@ __all__ = ["MpcRider"]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
-
-
-def _quaternion_zyx(roll: float, pitch: float, yaw: float) -> Array:
-    """(w, x, y, z) of :math:`R_z(\\psi) R_y(\\vartheta) R_x(\\phi)`."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return np.array(
-        [
-            cr * cp * cy + sr * sp * sy,
-            sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-        ]
-    )
 
 
 def _platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
@@ -110,7 +96,8 @@ class MpcRider(Controller):
         )
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
-        self.map = StateMap(self.pinocchio, reference.state_names, self.selector.prefixes)
+        self.layout = StateLayout.from_names(reference.state_names)
+        self.map = StateMap(self.pinocchio, reference.state_names, self.layout.prefixes)
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
         # achilles-rod constraint) drives the QP off (see the WBC's tests).
@@ -122,7 +109,6 @@ class MpcRider(Controller):
         self.wbc = WholeBodyController(robot, settings_wbc, pinocchio=self.pinocchio)
         self.kp = np.array([m.kp for m in robot.motors])
         self.kd = np.array([m.kd for m in robot.motors])
-        self.names = {name: i for i, name in enumerate(reference.state_names)}
         self._contact_foot = self._contacts_to_feet(reference.contact_names)
         self._tick = 0
         self._plan: Plan | None = None
@@ -161,7 +147,7 @@ class MpcRider(Controller):
     def _anchor(self, estimate: EstimatedState, now: float) -> None:
         self.manoeuvre = self.manoeuvre.started(now)
         window = self.mpc.reference.sample(self.manoeuvre.reference_time(now), 0, 1.0)
-        pose = self.selector.board_pose(self.names, window.states[0])
+        pose = self.layout.board_pose(window.states[0])
         self.map.anchor(estimate, pose)
 
     def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
@@ -201,7 +187,11 @@ class MpcRider(Controller):
             self.mpc.retarget(wanted.library_kind, wanted.target)
             reference = self.mpc.reference
             start = self.selector.phase_start(
-                reference.times, reference.states[:, self.names["vx"]], speed, now, wanted.kind
+                reference.times,
+                reference.states[:, self.layout.names["vx"]],
+                speed,
+                now,
+                wanted.kind,
             )
             self.manoeuvre = replace(wanted, start=start)
             self._anchor(estimate, now)
@@ -210,7 +200,7 @@ class MpcRider(Controller):
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
         problem = self.selector.with_command(
-            problem, self.names, command, self._roll_rate(command, now)
+            problem, self.layout.names, command, self._roll_rate(command, now)
         )
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
@@ -235,25 +225,22 @@ class MpcRider(Controller):
 
     def _speed(self, estimate: EstimatedState) -> float:
         if estimate.boards:
-            board = estimate.boards[0]
-            return float(
-                board.velocity[0] * math.cos(board.yaw) + board.velocity[1] * math.sin(board.yaw)
-            )
+            return forward_speed(estimate.boards[0])
         return float(np.linalg.norm(estimate.base_velocity[:2]))
 
     def _wbc_tick(self, estimate: EstimatedState, now: float) -> MotorCommand:
         plan = self._plan
         assert plan is not None
-        n = self.names
+        n = self.layout.names
         share = min(max((now - self._plan_time) * 30.0, 0.0), 1.0)
         x = (1.0 - share) * plan.states[0] + share * plan.states[1]
         frame = self.map.frame
         position = frame.point_to_world(np.array([x[n["com_x"]], x[n["com_y"]], x[n["com_z"]]]))
         velocity = frame.vector_to_world(np.array([x[n["vx"]], x[n["vy"]], x[n["vz"]]]))
-        base = self.selector.base_prefix
+        base = self.layout.base_prefix
         roll, pitch, yaw = (x[n[f"{base}{a}"]] for a in ("roll", "pitch", "yaw"))
-        orientation = _quaternion_zyx(roll, pitch, yaw + frame.yaw)
-        rotation = _rotation_zyx(roll, pitch, yaw + frame.yaw)
+        rotation = euler_zyx_matrix(roll, pitch, yaw + frame.yaw)
+        orientation = matrix_to_quaternion(rotation)
         omega_body = np.array([x[n["wx"]], x[n["wy"]], x[n["wz"]]])
         index = self.mpc.reference.force_index
         feet = len(self.robot.params.foot_bodies)
@@ -303,16 +290,3 @@ class MpcRider(Controller):
             else {"time_s": self._hold_time, "reason": self._hold_reason}
         )
         return out
-
-
-def _rotation_zyx(roll: float, pitch: float, yaw: float) -> Array:
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )

@@ -37,21 +37,20 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState
+from ridempc.estimation.rotations import rpy_of_matrix
 from ridempc.estimation.state import BoardEstimate
 from ridempc.robots.pinocchio_model import PinocchioRobot
 
-__all__ = ["RATE_FILTER_HZ", "PlanarFrame", "StateMap"]
+__all__ = ["RATE_FILTER_HZ", "PlanarFrame", "StateMap", "forward_speed"]
 
 Array = NDArray[np.float64]
 RATE_FILTER_HZ: float = 15.0  # [Hz] on the differentiated platform angles
 
 
-def _euler_zyx(rotation: Array) -> tuple[float, float, float]:
-    """(roll, pitch, yaw) [rad] of :math:`R = R_z R_y R_x`."""
-    pitch = -math.asin(max(-1.0, min(1.0, float(rotation[2, 0]))))
-    roll = math.atan2(float(rotation[2, 1]), float(rotation[2, 2]))
-    yaw = math.atan2(float(rotation[1, 0]), float(rotation[0, 0]))
-    return roll, pitch, yaw
+def forward_speed(board: BoardEstimate) -> float:
+    """The platform's speed along its heading, :math:`\\dot c \\cdot (\\cos\\psi, \\sin\\psi)`
+    [m/s]."""
+    return float(board.velocity[0] * math.cos(board.yaw) + board.velocity[1] * math.sin(board.yaw))
 
 
 def _wrap(angle: float) -> float:
@@ -174,9 +173,7 @@ class StateMap:
         if field == "roll":
             return board.roll
         if field in ("v", "speed"):
-            return float(
-                board.velocity[0] * math.cos(board.yaw) + board.velocity[1] * math.sin(board.yaw)
-            )
+            return forward_speed(board)
         angle = {
             "theta_dot": board.pitch,
             "theta_rate": board.pitch,
@@ -195,7 +192,7 @@ class StateMap:
         com = pin.centerOfMass(model, data, estimate.q, estimate.v)
         com_velocity = np.array(data.vcom[0])
         rotation = estimate.rotation
-        roll, pitch, yaw = _euler_zyx(rotation)
+        roll, pitch, yaw = rpy_of_matrix(rotation)
         angles = (roll, pitch, _wrap(yaw - self.frame.yaw))
         com_lib = self.frame.point_to_library(com)
         velocity_lib = self.frame.vector_to_library(com_velocity)

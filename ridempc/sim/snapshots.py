@@ -2,7 +2,7 @@
 
 Cheaper than a video (a handful of renders instead of 30 a second) and the picture a report
 shows: each frame is rendered from a camera tracking the rider's base, as in
-:class:`~ridempc.sim.video.VideoRecorder`, and labelled with its time. The PNG is written
+:func:`~ridempc.sim.video.tracking_camera`, and labelled with its time. The PNG is written
 to a temporary name and renamed into place, so a failed run never leaves half an image.
 """
 
@@ -12,6 +12,8 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+
+from ridempc.sim.video import tracking_camera
 
 __all__ = ["SnapshotStrip"]
 
@@ -46,12 +48,7 @@ class SnapshotStrip:
         self.path = Path(path)
         self.times = np.linspace(0.0, duration, count) if count > 1 else np.array([duration])
         self._renderer = mujoco.Renderer(model, height=height, width=width)
-        self._camera = mujoco.MjvCamera()
-        self._camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
-        self._camera.trackbodyid = track_body
-        self._camera.distance = distance
-        self._camera.azimuth = 135.0
-        self._camera.elevation = -15.0
+        self._camera = tracking_camera(track_body, distance)
         self.frames: list[tuple[float, np.ndarray]] = []
 
     def __call__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:

@@ -7,7 +7,18 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-__all__ = ["VideoRecorder"]
+__all__ = ["VideoRecorder", "tracking_camera"]
+
+
+def tracking_camera(track_body: int, distance: float) -> mujoco.MjvCamera:
+    """A camera following ``track_body`` from ``distance`` [m], front-left and a little above."""
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+    camera.trackbodyid = track_body
+    camera.distance = distance
+    camera.azimuth = 135.0
+    camera.elevation = -15.0
+    return camera
 
 
 class VideoRecorder:
@@ -32,12 +43,7 @@ class VideoRecorder:
         self.path = Path(path)
         self._tmp = self.path.with_name(f".{self.path.name}.tmp.mp4")
         self._renderer = mujoco.Renderer(model, height=height, width=width)
-        self._camera = mujoco.MjvCamera()
-        self._camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
-        self._camera.trackbodyid = track_body
-        self._camera.distance = distance
-        self._camera.azimuth = 135.0
-        self._camera.elevation = -15.0
+        self._camera = tracking_camera(track_body, distance)
         self._writer = imageio.get_writer(self._tmp, fps=fps, macro_block_size=1)
         self.frames = 0
         self.last_frame: np.ndarray | None = None
