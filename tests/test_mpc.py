@@ -364,3 +364,18 @@ def test_settings_are_checked() -> None:
         MpcSettings(horizon=0)
     assert MpcSettings().dt == pytest.approx(1.0 / 30.0)
     assert ROWS_PER_CONTACT == 5
+
+
+def test_fixed_inputs_are_held_over_the_horizon() -> None:
+    """The Segway's knee bar pinned at zero: every plan step keeps it there, and an unknown
+    name is refused."""
+    settings = MpcSettings(fixed_inputs={"knee_bar": 0.0})
+    mpc = LinearMpc.from_library("cassie", "segway", "turn", 0.5, settings=settings)
+    bar = list(mpc.reference.input_names).index("knee_bar")
+    assert np.max(np.abs(mpc.reference.inputs[:, bar])) > 0.01  # the library turns with it
+    plan = mpc.update(1.0, mpc.reference.states[30])
+    assert np.max(np.abs(plan.inputs[:, bar])) < 1e-6
+    with pytest.raises(ConfigError, match="fixed input 'steering'"):
+        LinearMpc.from_library(
+            "cassie", "segway", "turn", 0.5, settings=MpcSettings(fixed_inputs={"steering": 0.0})
+        )

@@ -62,6 +62,13 @@ def test_board_rates_are_the_reduced_model(board: str) -> None:
         expected = np.concatenate(
             [shoe_dynamics(xb[7 * i : 7 * i + 7], torques[i], wheeled.reduced) for i in range(2)]
         )
+        # eq. (8) on the bare shoe, pushed by the rider along the platform's x axis
+        for i in range(2):
+            heading, theta = xb[7 * i + 2], xb[7 * i + 3]
+            mine = [k for k, p in enumerate(layout["platform_of"]) if p == i]
+            along = np.cos(heading) * forces[mine, 0] + np.sin(heading) * forces[mine, 1]
+            push = -float(np.sum(np.cos(theta) * along - np.sin(theta) * forces[mine, 2]))
+            expected[7 * i + 6] = (wheeled.reduced.c4 * theta + push) / wheeled.shoe_mass
     else:
         assert isinstance(wheeled, SegwayBoard)
         expected = np.array(segway_dynamics(xb, (torques[0][0], extra[0]), wheeled.reduced))

@@ -214,4 +214,3 @@ class CassieSegway(CassieStanding):
             com_y_target=nominal.com_y + shift_y,
         )
         return replace(nominal, com_x=nominal.com_x + shift_x, com_y=nominal.com_y + shift_y)
-

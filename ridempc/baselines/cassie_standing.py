@@ -75,6 +75,7 @@ from ridempc.baselines.cassie_standing_gains import (
 )
 from ridempc.baselines.cassie_statics import FootLoad, StandingStatics
 from ridempc.baselines.filters import LowPassFilter
+from ridempc.boards import support_height
 from ridempc.controllers.base import Controller
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.robots.robot import Robot
@@ -140,7 +141,9 @@ class CassieStanding(Controller):
             platforms = (robot.params.foot_bodies,) if board != "none" else ()
         # Runs on every tick, so every ride reports the estimator's error; the riders on a
         # board read its state, standing reads only the IMU and the encoders.
-        self.estimator = StateEstimator(robot, platforms=platforms)
+        self.estimator = StateEstimator(
+            robot, platforms=platforms, support_height=support_height(board)
+        )
         self.gains = gains if isinstance(gains, CassieStandingGains) else load_standing_gains(gains)
         self.rate_hz = self.gains.rate_hz
         self.kinematics = CassieKinematics(robot)

@@ -97,6 +97,7 @@ from ridempc.baselines.quadruped_skateboard_gains import (
     load_quadruped_skateboard_gains,
 )
 from ridempc.baselines.quadruped_support import SupportPlane, fit_support_plane, vertical_loads
+from ridempc.boards import support_height
 from ridempc.boards.registry import load_board
 from ridempc.boards.skateboard.parameters import (
     SkateboardParameters,
@@ -280,7 +281,11 @@ class QuadrupedSkateboardPD(Controller):
         # Not used by the control law (the deck is read from the feet above); it runs so that
         # every ride reports the estimator's error against the truth.
         feet = robot.params.foot_bodies
-        self.estimator = StateEstimator(robot, platforms=(feet,) if board != "none" else ())
+        self.estimator = StateEstimator(
+            robot,
+            platforms=(feet,) if board != "none" else (),
+            support_height=support_height(board),
+        )
 
     # ------------------------------------------------------------------ state
 

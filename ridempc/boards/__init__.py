@@ -4,7 +4,7 @@ from ridempc.boards.board import Board, load_board_file
 from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.boards.kinds import BOARD_KINDS, BoardKind, board_kind
 from ridempc.boards.parameters import BoardParameters
-from ridempc.boards.registry import NO_BOARD, board_names, check_board, load_board
+from ridempc.boards.registry import NO_BOARD, board_names, check_board, load_board, support_height
 
 __all__ = [
     "BOARD_KINDS",
@@ -19,4 +19,5 @@ __all__ = [
     "check_board",
     "load_board",
     "load_board_file",
+    "support_height",
 ]

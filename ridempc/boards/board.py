@@ -7,6 +7,7 @@ from functools import cached_property
 from pathlib import Path
 
 import mujoco
+import numpy as np
 
 from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.boards.kinds import BoardKind, board_kind
@@ -51,6 +52,13 @@ class Board:
     def mass(self) -> float:
         """Total mass [kg]."""
         return float(self.mj_model.body_mass.sum())
+
+    @cached_property
+    def platform_top(self) -> float:
+        """Mean height of the platform sites (the decks' top surfaces) at rest [m]."""
+        data = mujoco.MjData(self.mj_model)
+        mujoco.mj_forward(self.mj_model, data)
+        return float(np.mean([data.site(s).xpos[2] for s in self.params.platform_sites]))
 
     def mjcf(self) -> str:
         """The board's description as MJCF text (what Pinocchio reads)."""

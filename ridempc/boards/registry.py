@@ -28,3 +28,10 @@ def load_board(name: str) -> Board | None:
     if name == NO_BOARD:
         return None
     return load_board_file(boards_dir() / name / "board.toml")
+
+
+def support_height(name: str) -> float:
+    """Height the rider's feet stand at on that board at rest [m]: its decks' top, 0 on the
+    ground (the state estimator's first height prior)."""
+    board = load_board(name)
+    return 0.0 if board is None else board.platform_top

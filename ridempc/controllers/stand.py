@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ridempc.boards import support_height
 from ridempc.controllers.base import Controller
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.robots.robot import Robot
@@ -32,7 +33,11 @@ class StandController(Controller):
         super().__init__(robot, board)
         self._hold: MotorCommand | None = None
         feet = robot.params.foot_bodies
-        self.estimator = StateEstimator(robot, platforms=(feet,) if board != "none" else ())
+        self.estimator = StateEstimator(
+            robot,
+            platforms=(feet,) if board != "none" else (),
+            support_height=support_height(board),
+        )
 
     def reset(self, sensors: SensorPacket) -> None:
         n = len(self.robot.motors)  # the motor joints lead the encoder list

@@ -63,6 +63,9 @@ class StateEstimator:
             the skateboard's deck, each hovershoe). Their support velocity is free, and
             :attr:`EstimatedState.boards` holds one estimate per group. Empty on the ground.
         pinocchio: The robot's Pinocchio model (built from ``robot`` if not given).
+        support_height: Height of the surface the feet stand on when the estimator starts
+            [m]: a board's deck top at rest (:attr:`~ridempc.boards.Board.platform_top`),
+            0 on the ground. Until the first VIO sample arrives it is the only height prior.
 
     Raises:
         ConfigError: A name in ``platforms`` is not a foot or is in two groups, or the
@@ -75,8 +78,10 @@ class StateEstimator:
         params: EstimatorParameters | None = None,
         platforms: Sequence[Sequence[str]] = (),
         pinocchio: PinocchioRobot | None = None,
+        support_height: float = 0.0,
     ) -> None:
         self.robot = robot
+        self.support_height = float(support_height)
         self.params = params or EstimatorParameters()
         self.pinocchio = pinocchio or build_pinocchio_robot(robot)
         self.model: pin.Model = pin.Model(self.pinocchio.model)  # a copy: closures add frames
@@ -145,7 +150,8 @@ class StateEstimator:
             base_position: Prior base position [m], held with the parameters' wide initial
                 standard deviations. Default: the VIO's if a sample has arrived (held at
                 the VIO's), otherwise horizontal zero with the lowest contact point on a
-                support at :math:`z = 0`.
+                support at :math:`z` = ``support_height`` (the board's deck top at rest, 0 on
+                the ground).
         """
         attitude, q, v, legs = self._sense(packet)
         self.contact.contact[:] = True
@@ -158,7 +164,9 @@ class StateEstimator:
         elif packet.vio is not None:
             prior = np.array(packet.vio.position, dtype=float)
         else:
-            prior = np.array([0.0, 0.0, -float(np.min(legs.site_position[:, 2]))])
+            prior = np.array(
+                [0.0, 0.0, self.support_height - float(np.min(legs.site_position[:, 2]))]
+            )
         x, P = self.odometry.initial_state(
             prior + legs.imu_position,
             np.zeros(3),

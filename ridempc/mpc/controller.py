@@ -48,6 +48,9 @@ class MpcSettings:
         terminal_factor: :math:`Q_N = ` this :math:`\\times Q` [-].
         weights: Overrides of :math:`Q` and :math:`R` by state or input name.
         osqp: Overrides of the QP's OSQP settings.
+        fixed_inputs: Inputs held at a value over the whole horizon, by name (an input the
+            rider cannot realise, such as the Segway's knee bar when nothing pushes it, must
+            not be planned with).
     """
 
     horizon: int = 12
@@ -55,6 +58,7 @@ class MpcSettings:
     terminal_factor: float = 10.0
     weights: Mapping[str, float] = field(default_factory=dict)
     osqp: Mapping[str, float | int | bool] = field(default_factory=dict)
+    fixed_inputs: Mapping[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.horizon < 1:
@@ -107,6 +111,13 @@ class LinearMpc:
             pair.weight / len(pair.contacts),
             self.settings.weights,
         )
+        names = list(reference.input_names)
+        unknown = [n for n in self.settings.fixed_inputs if n not in names]
+        if unknown:
+            raise ConfigError(
+                f"MPC fixed input '{unknown[0]}' is not an input (valid: {', '.join(names)})"
+            )
+        self._fixed = [(names.index(n), float(v)) for n, v in self.settings.fixed_inputs.items()]
         self.structure = QPStructure(
             model.state_pattern,
             model.input_pattern,
@@ -168,6 +179,8 @@ class LinearMpc:
             self.pair.max_force,
         )
         u_lo, u_hi = force_bounds(index, window.contacts, self.pair.input_limits)
+        for i, value in self._fixed:
+            u_lo[:, i] = u_hi[:, i] = value
         return MpcProblem(
             initial_state=x0,
             A=dynamics.A,

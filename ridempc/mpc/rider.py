@@ -40,6 +40,7 @@ from ridempc.mpc.manoeuvre import Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.reference import select_reference
 from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -54,6 +55,10 @@ __all__ = ["MpcRider"]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
+# Board inputs of the library that this rider does not realise, held at zero in the MPC: the
+# Segway's knee bar (the rider stands clear of the pad; planning turns with a bar nobody
+# pushes let the yaw run off: stand-still fell at 1.5 s, pinned it stands).
+UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 
 
 def _platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
@@ -87,10 +92,18 @@ class MpcRider(Controller):
         loaded = load_board(board)
         n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
         self.platform_feet = _platform_feet(robot, n_platforms)
-        self.estimator = StateEstimator(robot, platforms=self.platform_feet)
+        self.estimator = StateEstimator(
+            robot,
+            platforms=self.platform_feet,
+            support_height=loaded.platform_top if loaded is not None else 0.0,
+        )
         self.pinocchio = build_pinocchio_robot(robot)
         self.selector = ManoeuvreSelector(robot.name, board)
         first = self.selector.initial()
+        settings = settings or MpcSettings()
+        names = select_reference(robot.name, board, first.library_kind, first.target).input_names
+        pinned = {n: 0.0 for n in UNREALISED_INPUTS if n in names}
+        settings = replace(settings, fixed_inputs={**pinned, **settings.fixed_inputs})
         self.mpc = LinearMpc.from_library(
             robot.name, board, first.library_kind, first.target, settings
         )
@@ -110,6 +123,9 @@ class MpcRider(Controller):
         self.kp = np.array([m.kp for m in robot.motors])
         self.kd = np.array([m.kd for m in robot.motors])
         self._contact_foot = self._contacts_to_feet(reference.contact_names)
+        # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
+        # applies the MPC's centre of pressure along each foot, not an even share.
+        self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
         self._tick = 0
         self._plan: Plan | None = None
         self._last_problem: MpcProblem | None = None
@@ -247,8 +263,10 @@ class MpcRider(Controller):
         forces = np.zeros((feet, 3))
         contact = np.zeros(feet, dtype=bool)
         u = plan.first_input
+        site_forces = np.zeros((len(self._contact_foot), 3))
         for i, foot in enumerate(self._contact_foot):
             f = frame.vector_to_world(u[index[i]])
+            site_forces[i] = f
             forces[foot] += f
             contact[foot] |= bool(f[2] > 1e-3)
         if not contact.any():
@@ -260,6 +278,7 @@ class MpcRider(Controller):
             forces=forces,
             velocity=velocity,
             angular_velocity=rotation @ omega_body,
+            site_forces=site_forces if self._sites_match else None,
         )
         out = self.wbc.solve(estimate, targets)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)

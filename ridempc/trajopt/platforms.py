@@ -5,7 +5,8 @@ platform pitch and the pitch into forward acceleration; the reduced models (iden
 ``boards/<name>/board.toml``) are reused with ``xp = casadi``:
 
 - :class:`HovershoesBoard`: two shoes, each :mod:`ridempc.boards.hovershoes.reduced`
-  (eq. 4-8 of the hovershoe paper) driven by the torques of eq. (9) from the foot on it;
+  (eq. 4-8 of the hovershoe paper) driven by the torques of eq. (9) from the foot on it,
+  and by the foot's push along the shoe (eq. 8 below);
 - :class:`SegwayBoard`: one platform, :mod:`ridempc.boards.segway.reduced` (eq. 4', 5',
   8'), driven by the rider's pitch torque (eq. 9) and the knee-bar angle, an input here.
 
@@ -35,7 +36,7 @@ from ridempc.boards.segway.reduced import segway_dynamics
 from ridempc.errors import ConfigError
 from ridempc.trajopt.rotations import rotation_z, stack3x3
 
-__all__ = ["HovershoesBoard", "SegwayBoard", "WheeledBoard", "wheeled_board"]
+__all__ = ["HovershoesBoard", "SegwayBoard", "WheeledBoard", "platform_pushes", "wheeled_board"]
 
 Array = NDArray[np.float64]
 
@@ -72,9 +73,29 @@ class _Common:
 
 @dataclass(frozen=True)
 class HovershoesBoard(_Common):
-    """Two Hovershoes; platform 0 is the left shoe (+y), 1 the right."""
+    """Two Hovershoes; platform 0 is the left shoe (+y), 1 the right.
+
+    **The rider's push.** Eq. (8), :math:`m \\dot v = c_4 \\theta`, was identified with a
+    dead weight riding along, so :math:`m` [kg] is the shoe's and its load's mass: it holds
+    while the load keeps the shoe's speed. A rider may push its shoe instead; on the bare
+    shoe (mass :math:`m_s`, from the board's description) the firmware's drive
+    :math:`c_4 \\theta` and the rider's push :math:`P` [N] (the rider's force on the shoe
+    along its heading) give
+
+    .. math:: m_s \\dot v = c_4 \\theta + P,
+
+    which is eq. (8) again when the load follows the shoe, :math:`P = -(m - m_s) \\dot v`.
+    Without it the MPC saw a free horizontal force: a 15 N push accelerates a 2.7 kg shoe at
+    5.5 m/s^2, which the model had at zero (measured on the stand-still ride, where every
+    plan then swung the shoes back and forth).
+
+    Attributes:
+        reduced: The identified eq. (4)-(8).
+        shoe_mass: :math:`m_s` [kg], one shoe without its load.
+    """
 
     reduced: HovershoesReducedParameters
+    shoe_mass: float
 
     @property
     def n_platforms(self) -> int:
@@ -105,14 +126,16 @@ class HovershoesBoard(_Common):
     def pitch_rate(self, xb: Any, platform: int) -> Any:
         return self.platform_state(xb, platform)[4]
 
-    def rates(self, xb: Any, torques: list[tuple[Any, Any]], extra: Any) -> Any:
-        """Eq. (4)-(8) per shoe under the rider's torques :math:`(u_\\theta, u_\\psi)`."""
-        return ca.vertcat(
-            *[
-                ca.vertcat(*shoe_dynamics(self.platform_state(xb, i), torques[i], self.reduced, ca))
-                for i in range(2)
-            ]
-        )
+    def rates(self, xb: Any, torques: list[tuple[Any, Any]], extra: Any, pushes: list[Any]) -> Any:
+        """Eq. (4)-(7) per shoe under the rider's torques :math:`(u_\\theta, u_\\psi)`, and
+        eq. (8) with the rider's push (the class docstring)."""
+        out = []
+        for i in range(2):
+            state = self.platform_state(xb, i)
+            rates = list(shoe_dynamics(state, torques[i], self.reduced, ca))
+            rates[6] = (self.reduced.c4 * state[3] + pushes[i]) / self.shoe_mass
+            out.append(ca.vertcat(*rates))
+        return ca.vertcat(*out)
 
     def steady(self, speed: float, origins: Array) -> Array:
         """Both shoes rolling straight at ``speed`` with no pitch, at ``origins`` (2 x 2)."""
@@ -152,9 +175,10 @@ class SegwayBoard(_Common):
     def pitch_rate(self, xb: Any, platform: int) -> Any:
         return xb[4]
 
-    def rates(self, xb: Any, torques: list[tuple[Any, Any]], extra: Any) -> Any:
+    def rates(self, xb: Any, torques: list[tuple[Any, Any]], extra: Any, pushes: list[Any]) -> Any:
         """Eq. (4'), (5'), (8') under the rider's pitch torque and the knee-bar angle (the
-        rider's yaw torque goes into the wheels, not into the model)."""
+        rider's yaw torque goes into the wheels, not into the model; so does its push: the
+        Segway's 12.8 kg, held by its drive, is left as identified with its load)."""
         return ca.vertcat(*segway_dynamics(xb, (torques[0][0], extra[0]), self.reduced, ca))
 
     def steady(self, speed: float, origins: Array) -> Array:
@@ -201,6 +225,7 @@ def wheeled_board(board: Board, pitch_limit: float = 0.25) -> WheeledBoard:
             # Tyre breakaway: the rims creep linearly (the model's c3) up to about 4 N m.
             yaw_torque_limit=4.0,
             reduced=params.reduced,
+            shoe_mass=board.mass / 2.0,
         )
     if isinstance(params, SegwayParameters):
         assert params.reduced is not None
@@ -231,3 +256,17 @@ def platform_torques(
         local = [rotation.T @ forces[k] for k in mine]
         torques.append(contact_torques(positions, local))
     return torques
+
+
+def platform_pushes(
+    board: WheeledBoard, xb: Any, forces: list[Any], platform_of: list[int]
+) -> list[Any]:
+    """Per platform, the rider's push along its heading [N]: :math:`P = -\\sum_k
+    (R^\\top F_k)_x` over its contacts, :math:`F_k` the contact forces on the rider (world)."""
+    pushes = []
+    for i in range(board.n_platforms):
+        rotation, _ = board.pose(xb, i)
+        mine = [k for k, p in enumerate(platform_of) if p == i]
+        push = ca.SX(0.0) if not mine else -sum((rotation.T @ forces[k])[0] for k in mine)
+        pushes.append(push)
+    return pushes

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
-from ridempc.trajopt.platforms import WheeledBoard, platform_torques
+from ridempc.trajopt.platforms import WheeledBoard, platform_pushes, platform_torques
 from ridempc.trajopt.problem import NodeSpec, NodeTerms, TrajectoryProblem, assemble_problem
 from ridempc.trajopt.rider import RiderModel
 from ridempc.trajopt.rigid_body import GRAVITY, rigid_body_rates
@@ -142,9 +142,10 @@ def ride_rates(rider: RiderModel, board: WheeledBoard) -> ca.Function:
     forces = [u[3 * k : 3 * k + 3] for k in range(nc)]
     points = _contact_points(board, xb, layout)
     torques = platform_torques(board, xb, forces, points, layout["platform_of"])
+    pushes = platform_pushes(board, xb, forces, layout["platform_of"])
     rates = ca.vertcat(
         rigid_body_rates(rider.body, x[:12], forces, points, ca.SX(0, 1)),
-        board.rates(xb, torques, u[3 * nc :]),
+        board.rates(xb, torques, u[3 * nc :], pushes),
     )
     return ca.Function("ride_rates", [x, u, p], [rates])
 

@@ -55,6 +55,11 @@ class WbcTargets:
         posture: Nominal motor joint angles [rad], actuator order; None: the controller's.
         board_acceleration: Per board estimate in ``EstimatedState.boards``, the platform
             origin's acceleration [m/s^2]; empty or missing entries mean zero.
+        site_forces: The support's force on each contact site [N], shape (sites, 3), in
+            ``robot.params.contact_sites`` order, or None. When given, each standing site's
+            force is drawn to it, so the MPC's centre of pressure along a line foot (what
+            pitches a hovershoe) is the one applied; when None, a foot's force is shared
+            evenly between its sites and the motion tasks choose the centre of pressure.
     """
 
     position: Array
@@ -70,6 +75,7 @@ class WbcTargets:
     swing_acceleration: Array | None = None
     posture: Array | None = None
     board_acceleration: tuple[Array, ...] = ()
+    site_forces: Array | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -94,6 +100,10 @@ class WbcTargets:
             value = getattr(self, name)
             if value is not None:
                 _check_shape(name, value, (feet, 3))
+        if self.site_forces is not None:
+            sites = np.asarray(self.site_forces)
+            _check_shape("site_forces", sites, (len(sites), 3))
+            object.__setattr__(self, "site_forces", np.asarray(sites, dtype=float))
         for k, acceleration in enumerate(self.board_acceleration):
             _check_shape(f"board_acceleration[{k}]", acceleration, (3,))
 

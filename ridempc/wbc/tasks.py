@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from ridempc.errors import ConfigError
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms, PointKinematics
@@ -246,11 +247,27 @@ class ContactForceTask(Task):
             tangential * weight[:, None, None]
         ).ravel()
         wanted = np.asarray(targets.forces, dtype=float).ravel()
+        if targets.site_forces is None:
+            site_wanted = share @ wanted
+        else:
+            if targets.site_forces.shape != (len(self._site_foot), 3):
+                raise ConfigError(
+                    f"WBC targets: field 'site_forces': expected shape "
+                    f"({len(self._site_foot)}, 3), got {targets.site_forces.shape}"
+                )
+            # the MPC's own site forces, normal part included, at the site weight (holding
+            # them as strongly as the feet's totals felled Cassie on the Segway at 1.2 s)
+            site_hessian[self._block_rows, self._block_cols] = np.repeat(weight, 9) * np.tile(
+                _EYE3.ravel(), len(weight)
+            )
+            site_wanted = targets.site_forces.ravel() * np.repeat(
+                standing[self._site_foot].astype(float), 3
+            )
         n, forces = self.layout.size, self.layout.force
         hessian = np.zeros((n, n))
         hessian[forces, forces] = foot_hessian + site_hessian
         gradient = np.zeros(n)
-        gradient[forces] = foot_gradient @ wanted - site_hessian @ (share @ wanted)
+        gradient[forces] = foot_gradient @ wanted - site_hessian @ site_wanted
         return hessian, gradient
 
 
