@@ -26,6 +26,8 @@ from ridempc.mpc import (
     select_reference,
 )
 from ridempc.mpc.friction import ROWS_PER_CONTACT
+from ridempc.mpc.manoeuvre import RETARGET_BAND, ManoeuvreSelector
+from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
 PAIRS = [
@@ -379,3 +381,24 @@ def test_fixed_inputs_are_held_over_the_horizon() -> None:
         LinearMpc.from_library(
             "cassie", "segway", "turn", 0.5, settings=MpcSettings(fixed_inputs={"steering": 0.0})
         )
+
+
+def test_a_ramped_command_retargets_in_steps_not_at_every_tick() -> None:
+    selector = ManoeuvreSelector("cassie", "segway")
+    current = selector.initial()
+    assert selector.select(Command(velocity=0.01), current, 0.0, 0.0) is current  # rest: hold
+    targets = []
+    for t in np.arange(0.0, 1.0 + 1e-9, 1.0 / 30.0):  # 0 -> 1 m/s over 1 s
+        wanted = selector.select(Command(velocity=float(t)), current, float(t), 0.0)
+        if wanted is not current:
+            targets.append(wanted.target)
+            current = wanted
+    assert len(targets) <= 1.0 / RETARGET_BAND + 1  # not 30 restarts
+    settled = selector.select(Command(velocity=1.0), current, 1.05, 0.0)  # the ramp has ended
+    current = settled if settled is not current else current
+    assert current.kind == "accelerate" and current.target == pytest.approx(1.0)
+    assert all(b - a >= RETARGET_BAND - 1e-9 for a, b in zip(targets, targets[1:], strict=False))
+    # a step beyond the band restarts at once; one inside it keeps the running manoeuvre
+    stepped = selector.select(Command(velocity=2.0), current, 2.0, 1.0)
+    assert stepped.target == pytest.approx(2.0)
+    assert selector.select(Command(velocity=2.1), stepped, 2.1, 1.0) is stepped

@@ -112,7 +112,7 @@ def _targets(wbc: WholeBodyController, q: np.ndarray, v: np.ndarray, contact) ->
     terms = wbc.model.update(q, v)
     contact = np.asarray(contact, dtype=bool)
     forces = np.zeros((len(contact), 3))
-    forces[contact, 2] = wbc.model.mass * GRAVITY / contact.sum()
+    forces[contact, 2] = wbc.model.mass * GRAVITY / max(int(contact.sum()), 1)
     return WbcTargets(
         position=terms.com.position + np.array([0.01, -0.005, 0.0]),
         orientation=_quaternion_wxyz(q),
@@ -322,16 +322,19 @@ def test_persistent_workspace_matches_a_fresh_solve(robot, solver: str) -> None:
     assert wbc.qp.setups == 1  # one workspace, its pattern fixed from the start
 
 
-def test_infeasible_qp_raises_wbc_failed() -> None:
+def test_infeasible_qp_is_retried_cold_then_raises_wbc_failed() -> None:
     robot = load_robot("cyberdog2")
     # 2 kN on every foot cannot be held with 12 N m motors
     wbc = WholeBodyController(robot, WbcSettings(min_normal_force=2000.0, max_normal_force=100))
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     q, v = _standing(robot, estimator, np.random.default_rng(3))
+    wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.zeros(4, dtype=bool)))  # in flight: fine
+    assert wbc.qp.setups == 1 and wbc.qp.cold_retries == 0
     with pytest.raises(WbcFailed, match="infeasible|maximum iterations") as info:
         wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool)))
     assert isinstance(info.value, RidempcError)
     assert info.value.problem.A.shape[1] == wbc.model.layout.size
+    assert wbc.qp.cold_retries == 1 and wbc.qp.setups == 2  # the warm failure retried cold
 
 
 def test_targets_are_checked() -> None:

@@ -18,7 +18,7 @@ pyramids with the surface rotations of that state, and solves:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -111,19 +111,28 @@ class LinearMpc:
             pair.weight / len(pair.contacts),
             self.settings.weights,
         )
-        names = list(reference.input_names)
-        unknown = [n for n in self.settings.fixed_inputs if n not in names]
-        if unknown:
-            raise ConfigError(
-                f"MPC fixed input '{unknown[0]}' is not an input (valid: {', '.join(names)})"
-            )
-        self._fixed = [(names.index(n), float(v)) for n, v in self.settings.fixed_inputs.items()]
+        self._fixed = self._fixed_indices(self.settings.fixed_inputs)
         self.structure = QPStructure(
             model.state_pattern,
             model.input_pattern,
             pyramid_pattern(reference.force_index, model.nu),
         )
         self.qp: MpcQP | None = None
+
+    def _fixed_indices(self, fixed: Mapping[str, float]) -> list[tuple[int, float]]:
+        names = list(self.reference.input_names)
+        unknown = [n for n in fixed if n not in names]
+        if unknown:
+            raise ConfigError(
+                f"MPC fixed input '{unknown[0]}' is not an input (valid: {', '.join(names)})"
+            )
+        return [(names.index(n), float(v)) for n, v in fixed.items()]
+
+    def fix_inputs(self, values: Mapping[str, float]) -> None:
+        """Hold more inputs, by name, at a value over the horizon (as ``fixed_inputs``)."""
+        fixed = {**self.settings.fixed_inputs, **values}
+        self._fixed = self._fixed_indices(fixed)
+        self.settings = replace(self.settings, fixed_inputs=fixed)
 
     @classmethod
     def from_library(

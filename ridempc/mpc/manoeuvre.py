@@ -9,6 +9,9 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   the two neighbouring ones where the library allows it), started *at the phase where the
   reference's speed equals the board's estimated speed*, so a step from 0.5 to 1.0 m/s picks
   up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily;
+  while the command is ramping, it is kept as long as the command stays within
+  ``RETARGET_BAND`` of its target (a ramp retargets in a few steps, not at every tick), and
+  it moves to the exact command once the command settles;
 - **stop** when the command returns to zero, where the library has ``stop`` entries (the
   skateboard has none: it coasts on, four-leg balancing).
 
@@ -31,11 +34,16 @@ from ridempc.library.store import library_folder
 from ridempc.mpc.problem import MpcProblem
 from ridempc.scenarios.scenario import Command
 
-__all__ = ["HOLD", "MOVING", "Manoeuvre", "ManoeuvreSelector", "StateLayout"]
+__all__ = ["HOLD", "MOVING", "RETARGET_BAND", "Manoeuvre", "ManoeuvreSelector", "StateLayout"]
 
 Array = NDArray[np.float64]
 MOVING: float = 0.05  # [m/s] a commanded speed below this is rest
 HOLD: str = "hold"
+# [m/s] a running ``accelerate`` is kept while the command stays this close to its target: a
+# ramped command would otherwise restart the trajectory at every MPC tick (the Segway's
+# 0 -> 1 m/s ramp over 1 s retargeted 30 times, its reference time jumping between 0 and
+# 1.3 s, and fell).
+RETARGET_BAND: float = 0.25
 
 
 @dataclass(frozen=True)
@@ -62,9 +70,6 @@ class Manoeuvre:
     def reference_time(self, now: float) -> float:
         """The reference's time [s]; a hold stays before the trajectory's start."""
         return -1.0 if self.kind == HOLD else now - self.start
-
-    def same_goal(self, other: Manoeuvre) -> bool:
-        return self.kind == other.kind and math.isclose(self.target, other.target, abs_tol=1e-6)
 
 
 @dataclass(frozen=True)
@@ -127,6 +132,7 @@ class ManoeuvreSelector:
             self.targets[entry.kind] = tuple(sorted({*self.targets[entry.kind], entry.target}))
         if "accelerate" not in self.targets:
             raise ConfigError(f"{folder / 'manifest.json'}: no 'accelerate' entries")
+        self._last_wanted: float | None = None  # the commanded speed at the last call
 
     def initial(self) -> Manoeuvre:
         return Manoeuvre(HOLD, self.targets["accelerate"][0])
@@ -146,9 +152,13 @@ class ManoeuvreSelector:
             if current.kind in (HOLD, "stop") or "stop" not in self.targets:
                 return current
             return Manoeuvre("stop", self._clamped("stop", max(speed, current.target)), now)
+        previous, self._last_wanted = self._last_wanted, wanted
         goal = Manoeuvre("accelerate", self._clamped("accelerate", wanted), now)
-        if current.kind == "accelerate" and current.same_goal(goal):
-            return current
+        if current.kind == "accelerate":
+            gap = abs(goal.target - current.target)
+            ramping = previous is not None and not math.isclose(previous, wanted, abs_tol=1e-9)
+            if gap < 1e-6 or (ramping and gap < RETARGET_BAND):
+                return current
         return goal
 
     @staticmethod

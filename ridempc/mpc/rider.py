@@ -17,9 +17,10 @@ Every 2 ms (500 Hz) the rider
 4. sends the QP's torques as feedforward with its joint targets to the motor PD.
 
 **Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
-fallback, counted); if the estimate is not finite, the WBC fails or anything raises, the
-rider holds its joints where they are with the robot's default gains from then on, and its
-``summary()`` says why and when.
+fallback, counted); if the WBC fails, its last command is sent again for up to
+``WBC_GRACE_TICKS`` ticks (counted); if the estimate is not finite, the WBC keeps failing or
+anything raises, the rider holds its joints where they are with the robot's default gains
+from then on, and its ``summary()`` says why and when.
 """
 
 from __future__ import annotations
@@ -40,7 +41,6 @@ from ridempc.mpc.manoeuvre import Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.reference import select_reference
 from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -49,6 +49,7 @@ from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
+from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.settings import WbcSettings
 
 __all__ = ["MpcRider"]
@@ -59,6 +60,9 @@ MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step
 # Segway's knee bar (the rider stands clear of the pad; planning turns with a bar nobody
 # pushes let the yaw run off: stand-still fell at 1.5 s, pinned it stands).
 UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
+# Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
+# QP that does not converge should not end a ride (the QP already retried it cold).
+WBC_GRACE_TICKS: int = 5
 
 
 def _platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
@@ -100,13 +104,12 @@ class MpcRider(Controller):
         self.pinocchio = build_pinocchio_robot(robot)
         self.selector = ManoeuvreSelector(robot.name, board)
         first = self.selector.initial()
-        settings = settings or MpcSettings()
-        names = select_reference(robot.name, board, first.library_kind, first.target).input_names
-        pinned = {n: 0.0 for n in UNREALISED_INPUTS if n in names}
-        settings = replace(settings, fixed_inputs={**pinned, **settings.fixed_inputs})
         self.mpc = LinearMpc.from_library(
             robot.name, board, first.library_kind, first.target, settings
         )
+        names = self.mpc.reference.input_names
+        pinned = {n: 0.0 for n in UNREALISED_INPUTS if n in names}
+        self.mpc.fix_inputs({**pinned, **self.mpc.settings.fixed_inputs})
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_names(reference.state_names)
@@ -132,6 +135,9 @@ class MpcRider(Controller):
         self._plan_time = 0.0
         self._command_roll: tuple[float, float] | None = None
         self._hold: MotorCommand | None = None
+        self._last_command: MotorCommand | None = None
+        self._wbc_misses = 0  # consecutive
+        self._wbc_failures = 0  # in all
         self._hold_reason: str | None = None
         self._hold_time: float | None = None
         self._mpc_ms: list[float] = []
@@ -191,8 +197,17 @@ class MpcRider(Controller):
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
             out = self._wbc_tick(estimate, sensors.time)
+        except WbcFailed as exc:
+            if self._last_command is None or self._wbc_misses >= WBC_GRACE_TICKS:
+                return self._safe_hold(sensors, f"WbcFailed at {sensors.time:.3f} s: {exc}")
+            self._wbc_misses += 1
+            self._wbc_failures += 1
+            self._tick += 1
+            return self._last_command
         except RidempcError as exc:
             return self._safe_hold(sensors, f"{type(exc).__name__} at {sensors.time:.3f} s: {exc}")
+        self._wbc_misses = 0
+        self._last_command = out
         self._tick += 1
         return out
 
@@ -303,6 +318,8 @@ class MpcRider(Controller):
         qp = self.mpc.qp
         out["mpc_solves"] = len(self._mpc_ms)
         out["mpc_fallbacks"] = int(qp.failures) if qp is not None else 0
+        out["wbc_failures"] = self._wbc_failures
+        out["wbc_cold_retries"] = self.wbc.qp.cold_retries
         out["safe_hold"] = (
             None
             if self._hold_reason is None

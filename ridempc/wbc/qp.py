@@ -30,6 +30,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import osqp
@@ -161,6 +162,7 @@ class WholeBodyQP:
     Attributes:
         setups: OSQP workspace set-ups so far (one at the first solve, one more each time
             the pattern had to widen, or after a failed solve, which restarts cold).
+        cold_retries: Warm-started solves that failed and were retried cold.
         last: The last solution, or None.
     """
 
@@ -183,6 +185,7 @@ class WholeBodyQP:
         self._a: _Pattern | None = None
         self._solver: osqp.OSQP | None = None
         self.setups = 0
+        self.cold_retries = 0
         self.last: QpSolution | None = None
 
     # ----------------------------------------------------------------- build
@@ -219,12 +222,13 @@ class WholeBodyQP:
 
         Raises:
             WbcFailed: OSQP's status is not ``solved`` or ``solved inaccurate``, or the
-                solution is not finite.
+                solution is not finite (after a retry from a cold start, if it was warm).
         """
         start = time.perf_counter()
         solver = self._solver
-        if solver is not None and self._fits(problem):
-            assert self._p is not None and self._a is not None
+        warm = solver is not None and self._fits(problem)
+        if warm:
+            assert solver is not None and self._p is not None and self._a is not None
             solver.update(
                 q=problem.q,
                 l=problem.l,
@@ -235,11 +239,18 @@ class WholeBodyQP:
         else:
             solver = self._setup(problem)
         result = solver.solve(raise_error=False)
+        if warm and not self._accepted(result):
+            # A warm start (iterates and adapted rho of the last tick) can stall where a
+            # cold one converges: Cassie on the Segway at 3.854 s ran out of 2000 iterations
+            # warm and solved in 1050 cold. Retry once from scratch.
+            self.cold_retries += 1
+            solver = self._setup(problem)
+            result = solver.solve(raise_error=False)
         info = result.info
         x = np.array(result.x)
         status = str(info.status)
         polished = int(info.status_polish) == 1
-        if status not in ACCEPTED or not np.all(np.isfinite(x)):
+        if not self._accepted(result):
             self._solver = None  # its iterates would warm-start the next tick from garbage
             raise WbcFailed(status, problem)
         refined = False
@@ -257,6 +268,11 @@ class WholeBodyQP:
         )
         self.last = solution
         return solution
+
+    @staticmethod
+    def _accepted(result: Any) -> bool:
+        """OSQP's status is accepted and its solution finite."""
+        return str(result.info.status) in ACCEPTED and bool(np.all(np.isfinite(result.x)))
 
     def _refine(self, problem: QpProblem, x: Array) -> tuple[Array, bool]:
         """Move an unpolished ADMM solution onto its active set exactly.
