@@ -46,27 +46,14 @@ from ridempc.errors import ConfigError
 from ridempc.trajopt.platforms import WheeledBoard, platform_pushes, platform_torques
 from ridempc.trajopt.problem import NodeSpec, NodeTerms, TrajectoryProblem, assemble_problem
 from ridempc.trajopt.rider import RiderModel
-from ridempc.trajopt.rigid_body import GRAVITY, rigid_body_rates
+from ridempc.trajopt.rigid_body import GRAVITY, rigid_body_rates, rigid_body_state_names
 from ridempc.trajopt.rotations import euler_zyx_matrix
 
 __all__ = ["KINDS", "RideOptions", "build_ride_problem", "ride_guess", "ride_layout", "ride_rates"]
 
 Array = NDArray[np.float64]
 KINDS = ("accelerate", "stop", "turn")
-_RIDER = (
-    "com_x",
-    "com_y",
-    "com_z",
-    "pelvis_roll",
-    "pelvis_pitch",
-    "pelvis_yaw",
-    "vx",
-    "vy",
-    "vz",
-    "wx",
-    "wy",
-    "wz",
-)
+_RIDER = rigid_body_state_names("pelvis")
 
 
 @dataclass(frozen=True)

@@ -51,10 +51,31 @@ __all__ = [
     "build_rigid_body_robot",
     "feet_world",
     "rigid_body_rates",
+    "rigid_body_state_names",
 ]
 
 Array = NDArray[np.float64]
 GRAVITY: float = 9.81  # [m] / [s]^2
+
+
+def rigid_body_state_names(base: str) -> tuple[str, ...]:
+    """Names of the single rigid body's 12 states of eq. (1), in order: centre of mass [m],
+    the ``base`` body's Z-Y-X angles [rad], CoM velocity [m/s], body angular rate [rad/s]."""
+    return (
+        "com_x",
+        "com_y",
+        "com_z",
+        f"{base}_roll",
+        f"{base}_pitch",
+        f"{base}_yaw",
+        "vx",
+        "vy",
+        "vz",
+        "wx",
+        "wy",
+        "wz",
+    )
+
 
 _FREE_FLYER_IDENTITY = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
 

@@ -46,7 +46,13 @@ from ridempc.trajopt.problem import (
     TrajectoryProblem,
     assemble_problem,
 )
-from ridempc.trajopt.rigid_body import GRAVITY, RigidBodyRobot, feet_world, rigid_body_rates
+from ridempc.trajopt.rigid_body import (
+    GRAVITY,
+    RigidBodyRobot,
+    feet_world,
+    rigid_body_rates,
+    rigid_body_state_names,
+)
 from ridempc.trajopt.rotations import euler_rate_map, euler_zyx_matrix
 from ridempc.trajopt.schedule import Contact, ContactSchedule, push_schedule
 from ridempc.trajopt.skateboard import BOARD_STATE, SkateboardModel, deck_frame, skateboard_rates
@@ -62,20 +68,7 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-_TRUNK = (
-    "com_x",
-    "com_y",
-    "com_z",
-    "trunk_roll",
-    "trunk_pitch",
-    "trunk_yaw",
-    "vx",
-    "vy",
-    "vz",
-    "wx",
-    "wy",
-    "wz",
-)
+_TRUNK = rigid_body_state_names("trunk")
 
 
 @dataclass(frozen=True)
