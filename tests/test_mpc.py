@@ -275,7 +275,6 @@ def test_infeasible_update_falls_back_to_the_shifted_plan(skate_mpc: LinearMpc) 
     assert not qp.solve(good).fallback
 
 
-
 def test_the_solve_budget_is_iterations_not_wall_time(skate_mpc: LinearMpc) -> None:
     """Without a time limit a solve cut at ``max_iter`` falls back, whatever the load."""
     good = skate_mpc.problem(0.0, skate_mpc.reference.states[0])
@@ -285,6 +284,7 @@ def test_the_solve_budget_is_iterations_not_wall_time(skate_mpc: LinearMpc) -> N
     assert plan.fallback and plan.iterations == 3 and qp.failures == 1
     roomy = skate_mpc.build_qp(good)
     assert not roomy.solve(good).fallback
+
 
 def test_problem_is_checked(skate_mpc: LinearMpc) -> None:
     good = skate_mpc.problem(0.0, skate_mpc.reference.states[0])

@@ -381,8 +381,8 @@ class MpcQP:
         """Update the QP with ``problem``, warm-start it, solve it (see the module docstring).
 
         Never raises for a failed solve: an infeasible problem, a solver error or a solve
-        beyond the iteration budget or time limit returns the previous plan shifted by one step (or, before
-        any plan, the problem's reference) with ``fallback`` set.
+        beyond the iteration budget or time limit returns the previous plan shifted by one
+        step (or, before any plan, the problem's reference) with ``fallback`` set.
 
         Raises:
             ValueError: As :meth:`update`.
