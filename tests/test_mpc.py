@@ -26,7 +26,7 @@ from ridempc.mpc import (
     select_reference,
 )
 from ridempc.mpc.friction import ROWS_PER_CONTACT
-from ridempc.mpc.manoeuvre import RETARGET_BAND, ManoeuvreSelector
+from ridempc.mpc.manoeuvre import RETARGET_BAND, ManoeuvreSelector, StateLayout
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
@@ -413,3 +413,35 @@ def test_a_ramped_command_retargets_in_steps_not_at_every_tick() -> None:
     stepped = selector.select(Command(velocity=2.0), current, 2.0, 1.0)
     assert stepped.target == pytest.approx(2.0)
     assert selector.select(Command(velocity=2.1), stepped, 2.1, 1.0) is stepped
+
+
+def test_a_commanded_roll_moves_the_reference_to_a_balance(skate_mpc: LinearMpc) -> None:
+    """Rolled by 0.05 rad with the static shift, the reference's force-driven accelerations
+    are what they were unrolled (to first order); rolled alone they are not."""
+    layout = StateLayout.from_names(skate_mpc.reference.state_names)
+    names, roll = layout.names, layout.names["board_roll"]
+    rider = [i for n, i in names.items() if not n.startswith(layout.prefixes)]
+    t = 6.0
+    shift = skate_mpc.static_shift(t, roll, rider)
+    window = skate_mpc.reference.sample(t, 1, skate_mpc.settings.dt)
+    x, u, p = window.states[0], window.inputs, window.parameters
+
+    def rates(state: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+        return skate_mpc.model.evaluate(state, inputs, p)[0][0]
+
+    base = rates(x, u)
+    delta = np.zeros_like(x)
+    delta[roll] = 0.05
+    alone = rates(x + delta, u) - base
+    balanced = rates(x + delta + 0.05 * shift.states, u + 0.05 * shift.inputs) - base
+    dynamic = [names[n] for n in ("vx", "vy", "vz", "wx", "wy", "wz", "board_roll_rate")]
+    assert np.abs(alone[dynamic]).max() > 10.0  # [rad/s^2] the trucks' spring, unheld
+    assert np.abs(balanced[dynamic]).max() < 0.05 * np.abs(alone[dynamic]).max()
+    # the rider leans to the low side; the board's own states stay
+    assert shift.states[names["com_y"]] < -0.1
+    assert not shift.states[[names[n] for n in names if n.startswith(layout.prefixes)]].any()
+    # rolling at 1 rad/s, the rider sways at the lean's rate
+    a_c = skate_mpc.model.evaluate(x, u, p)[1][0]
+    np.testing.assert_allclose(
+        (a_c @ shift.velocities)[names["com_y"]], shift.states[names["com_y"]], rtol=1e-6
+    )

@@ -17,7 +17,7 @@ pyramids with the surface rotations of that state, and solves:
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -31,7 +31,9 @@ from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MPC_STEP, LinearModel, MpcProblem, build_linear_model, linearize
 from ridempc.mpc.qp import MpcQP, QPStructure
 from ridempc.mpc.reference import MotionReference, select_reference, steady_riding
+from ridempc.mpc.statics import StaticShift, static_shift
 from ridempc.mpc.weights import bryson_weights
+from ridempc.trajopt.schedule import Contact
 
 __all__ = ["LinearMpc", "MpcSettings"]
 
@@ -206,6 +208,19 @@ class LinearMpc:
             constraint_upper=g_hi,
             dt=s.dt,
             terminal_weights=s.terminal_factor * self.state_weights,
+        )
+
+    def static_shift(self, t: float, changed: int, rider_states: Sequence[int]) -> StaticShift:
+        """How the reference at time ``t`` [s] moves, per unit change of state ``changed``,
+        to stay in balance (:func:`~ridempc.mpc.statics.static_shift`): the rider's pose
+        among ``rider_states`` (those no input drives) and the standing feet's forces."""
+        window = self.reference.sample(t, 1, self.settings.dt)
+        _, a_c, b_c = self.model.evaluate(window.states[0], window.inputs, window.parameters)
+        standing = [c is not Contact.SWING for c in window.contacts[0]]
+        forces = self.reference.force_index[np.asarray(standing)].ravel()
+        poses = [i for i in rider_states if not np.any(b_c[0][i])]
+        return static_shift(
+            a_c[0], b_c[0], changed, poses, forces, self.state_weights, self.input_weights
         )
 
     def build_qp(self, problem: MpcProblem, **osqp: float | int | bool) -> MpcQP:

@@ -17,7 +17,8 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
 
 Targets beyond the library's range are clamped to it. On top of the trajectory the command
 sets the deck roll (the skateboard's ``board_roll`` and ``board_roll_rate``, held over the
-horizon at the commanded rate) when it commands one.
+horizon at the commanded rate) when it commands one, and moves the rider's pose, sway and
+forces to the balance of that roll (:mod:`ridempc.mpc.statics`).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from numpy.typing import NDArray
 from ridempc.errors import ConfigError
 from ridempc.library.store import library_folder
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.statics import StaticShift
 from ridempc.scenarios.scenario import Command
 
 __all__ = ["HOLD", "MOVING", "RETARGET_BAND", "Manoeuvre", "ManoeuvreSelector", "StateLayout"]
@@ -173,15 +175,34 @@ class ManoeuvreSelector:
         return now - t_match
 
     @staticmethod
+    def commands_roll(names: dict[str, int], command: Command, roll_rate: float) -> bool:
+        """Whether the command sets a deck roll the reference has."""
+        return "board_roll" in names and (command.roll != 0.0 or roll_rate != 0.0)
+
+    @classmethod
     def with_command(
-        problem: MpcProblem, names: dict[str, int], command: Command, roll_rate: float
+        cls,
+        problem: MpcProblem,
+        names: dict[str, int],
+        command: Command,
+        roll_rate: float,
+        balance: StaticShift | None = None,
     ) -> MpcProblem:
-        """The problem with the commanded deck roll laid over the reference (if it has one)."""
-        if "board_roll" not in names or (command.roll == 0.0 and roll_rate == 0.0):
+        """The problem with the commanded deck roll laid over the reference (if it has one),
+        and with ``balance``, the reference's change per radian of roll and per rad/s of
+        roll rate (:meth:`~ridempc.mpc.controller.LinearMpc.static_shift`), moved to stay
+        in balance."""
+        if not cls.commands_roll(names, command, roll_rate):
             return problem
         states = problem.state_reference.copy()
+        inputs = problem.input_reference.copy()
         k = np.arange(states.shape[0])
-        states[:, names["board_roll"]] = command.roll + roll_rate * k * problem.dt
+        roll = names["board_roll"]
+        change = command.roll + roll_rate * k * problem.dt - states[:, roll]
+        if balance is not None:
+            states += np.outer(change, balance.states) + roll_rate * balance.velocities
+            inputs += np.outer(change[:-1], balance.inputs)
+        states[:, roll] = command.roll + roll_rate * k * problem.dt
         if "board_roll_rate" in names:
             states[:, names["board_roll_rate"]] = roll_rate
-        return replace(problem, state_reference=states)
+        return replace(problem, state_reference=states, input_reference=inputs)

@@ -230,9 +230,12 @@ class MpcRider(Controller):
         t_ref = self.manoeuvre.reference_time(now)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
-        problem = self.selector.with_command(
-            problem, self.layout.names, command, self._roll_rate(command, now)
-        )
+        names, roll_rate = self.layout.names, self._roll_rate(command, now)
+        balance = None
+        if self.selector.commands_roll(names, command, roll_rate):
+            rider = [i for n, i in names.items() if not n.startswith(self.layout.prefixes)]
+            balance = self.mpc.static_shift(t_ref, names["board_roll"], rider)
+        problem = self.selector.with_command(problem, names, command, roll_rate, balance)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem

@@ -16,17 +16,13 @@ from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
 from ridempc.errors import ConfigError
-from ridempc.mjcf import add_imu_sensors
+from ridempc.mjcf import STIFF_CONTACT, add_imu_sensors
 from ridempc.robots.robot import Robot
 
 __all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
 
 FOOT_CLEARANCE: float = 0.001  # [m] gap between the lowest foot point and the support at start
 FLOOR_FRICTION: tuple[float, float, float] = (1.0, 0.005, 0.0001)  # slide, spin, roll
-# A stiffer contact than MuJoCo's default (time constant 0.02 s), so feet sink millimetres,
-# not centimetres; the time constant stays above two physics steps (1.3 ms at 1500 Hz).
-GROUND_SOLREF: tuple[float, float] = (0.005, 1.0)  # time constant [s], damping ratio
-GROUND_SOLIMP: tuple[float, ...] = (0.95, 0.99, 0.001, 0.5, 2.0)  # impedance, width [m], shape
 # MuJoCo's soft contacts let a loaded foot creep down a tilted or turning platform (the
 # constraint force only builds up with slip velocity). Noslip iterations project the
 # friction forces back inside the cone after the main solve, so a standing foot holds.
@@ -127,8 +123,7 @@ def _add_world(spec: mujoco.MjSpec, physics_hz: int) -> None:
         conaffinity=3,
         condim=3,
         friction=list(FLOOR_FRICTION),
-        solref=list(GROUND_SOLREF),
-        solimp=list(GROUND_SOLIMP),
+        **STIFF_CONTACT,
     )
     spec.worldbody.add_light(
         name="sun", pos=[0, 0, 5], dir=[0, 0.2, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL

@@ -28,7 +28,7 @@ import numpy as np
 
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.parameters import BoardParameters
-from ridempc.mjcf import add_encoder_sensors, add_imu_sensors
+from ridempc.mjcf import STIFF_CONTACT, add_encoder_sensors, add_imu_sensors
 
 __all__ = ["SIDES", "build_hovershoes", "shoe_names"]
 
@@ -92,6 +92,7 @@ def _add_shoe(spec: mujoco.MjSpec, p: HovershoesParameters, index: int, y: float
         friction=[p.platform_friction, 0.005, 0.0001],
         rgba=_PAD_COLOUR,
         **_BOARD,
+        **STIFF_CONTACT,
     )
     # The shell in front of and behind the wheel (drawn only, it never touches anything).
     shell_half = [0.5 * p.platform_length * 0.9, 0.5 * p.platform_width * 0.95]

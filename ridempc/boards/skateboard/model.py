@@ -35,7 +35,7 @@ import math
 import mujoco
 
 from ridempc.boards.skateboard.parameters import SkateboardParameters
-from ridempc.mjcf import add_encoder_sensors, add_imu_sensors
+from ridempc.mjcf import STIFF_CONTACT, add_encoder_sensors, add_imu_sensors
 
 __all__ = [
     "DECK",
@@ -200,6 +200,7 @@ def build_skateboard(params: SkateboardParameters) -> mujoco.MjSpec:
         mass=params.deck_mass,
         rgba=_DECK_RGBA,
         **_COLLIDE,
+        **STIFF_CONTACT,
     )
     deck.add_geom(
         name=f"{DECK}_grip",
