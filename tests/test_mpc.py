@@ -420,9 +420,8 @@ def test_a_commanded_roll_moves_the_reference_to_a_balance(skate_mpc: LinearMpc)
     are what they were unrolled (to first order); rolled alone they are not."""
     layout = StateLayout.from_names(skate_mpc.reference.state_names)
     names, roll = layout.names, layout.names["board_roll"]
-    rider = [i for n, i in names.items() if not n.startswith(layout.prefixes)]
     t = 6.0
-    shift = skate_mpc.static_shift(t, roll, rider)
+    shift = skate_mpc.static_shift(t, roll, layout.rider_states)
     window = skate_mpc.reference.sample(t, 1, skate_mpc.settings.dt)
     x, u, p = window.states[0], window.inputs, window.parameters
 

@@ -102,6 +102,11 @@ class StateLayout:
             raise ConfigError(f"cannot tell the base's roll among the states {names}")
         return cls(prefixes, bases[0], {n: i for i, n in enumerate(names)})
 
+    @property
+    def rider_states(self) -> tuple[int, ...]:
+        """Indices of the states that are not a platform's (the rider's)."""
+        return tuple(i for n, i in self.names.items() if not n.startswith(self.prefixes))
+
     def board_pose(self, state: Array) -> tuple[float, float, float]:
         """The first platform's (x, y, heading) in a state."""
         prefix, names = self.prefixes[0], self.names
@@ -198,11 +203,12 @@ class ManoeuvreSelector:
         inputs = problem.input_reference.copy()
         k = np.arange(states.shape[0])
         roll = names["board_roll"]
-        change = command.roll + roll_rate * k * problem.dt - states[:, roll]
+        wanted = command.roll + roll_rate * k * problem.dt
         if balance is not None:
+            change = wanted - states[:, roll]
             states += np.outer(change, balance.states) + roll_rate * balance.velocities
             inputs += np.outer(change[:-1], balance.inputs)
-        states[:, roll] = command.roll + roll_rate * k * problem.dt
+        states[:, roll] = wanted
         if "board_roll_rate" in names:
             states[:, names["board_roll_rate"]] = roll_rate
         return replace(problem, state_reference=states, input_reference=inputs)

@@ -233,8 +233,7 @@ class MpcRider(Controller):
         names, roll_rate = self.layout.names, self._roll_rate(command, now)
         balance = None
         if self.selector.commands_roll(names, command, roll_rate):
-            rider = [i for n, i in names.items() if not n.startswith(self.layout.prefixes)]
-            balance = self.mpc.static_shift(t_ref, names["board_roll"], rider)
+            balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, command, roll_rate, balance)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
