@@ -69,3 +69,33 @@ def test_a_pair_without_an_mpc_is_refused(tmp_path, capsys) -> None:
     args = ["sim", "--robot", "cyberdog2", "--board", "none", "--controller", "mpc"]
     assert main([*args, "--out", str(tmp_path / "x")]) == 2
     assert "cyberdog2-none" in capsys.readouterr().err
+
+
+def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
+    """With the ride's command timeline the MPC's deck-roll reference is the command at
+    each node (rate by central differences); without it, the present command extrapolated
+    at its last rate, one MPC step late on a moving command."""
+    rider = MpcRider(dog, "skateboard")
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    scenario = resolve_scenario("roll-tracking", "skateboard")
+    Simulation(scene, rider, scenario)
+    assert rider.command_preview == scenario.command_at  # the simulation hands it over
+    mpc, names = rider.mpc, rider.layout.names
+    problem = mpc.problem(0.0, mpc.reference.sample(0.0, 0, mpc.settings.dt).states[0])
+    now = 6.5  # the command crosses zero at its fastest
+    times = now + problem.dt * np.arange(problem.state_reference.shape[0])
+    wanted = np.array([scenario.command_at(float(t)).roll for t in times])
+    assert np.ptp(wanted) > 0.05  # the command moves over the horizon
+    roll = rider._roll_horizon(scenario.command_at(now), now, problem)
+    np.testing.assert_allclose(roll, wanted)
+    laid = rider.selector.with_command(problem, names, roll)
+    np.testing.assert_allclose(laid.state_reference[:, names["board_roll"]], wanted)
+    np.testing.assert_allclose(
+        laid.state_reference[:, names["board_roll_rate"]], np.gradient(wanted, problem.dt)
+    )
+    rider.command_preview = None
+    step = 1.0 / 30.0
+    rider._roll_horizon(scenario.command_at(now - step), now - step, problem)
+    blind = rider._roll_horizon(scenario.command_at(now), now, problem)
+    assert blind[0] == pytest.approx(wanted[0])
+    assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend

@@ -9,6 +9,7 @@ A controller runs at its own rate (a divisor of the physics rate), reads only a
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ridempc.robots.robot import Robot
@@ -28,6 +29,10 @@ class Controller(ABC):
     Attributes:
         rate_hz: How often :meth:`update` runs [Hz].
         uses_ground_truth: True if it reads ``SensorPacket.truth`` (debugging only).
+        command_preview: The command at any time [s], where the ride's commands are planned
+            ahead (the simulation sets the scenario's timeline); None when only the
+            present command is known. A tracking controller (the MPC) may read the
+            reference over its horizon from it; nothing of the robot or board is in it.
     """
 
     rate_hz: float = 500.0
@@ -36,6 +41,7 @@ class Controller(ABC):
     def __init__(self, robot: Robot, board: str = "none") -> None:
         self.robot = robot
         self.board = board  # the board's name ("none" on flat ground)
+        self.command_preview: Callable[[float], Command] | None = None
 
     def reset(self, sensors: SensorPacket) -> None:  # noqa: B027 - optional hook
         """Called once with the first sensor packet, before the first :meth:`update`."""

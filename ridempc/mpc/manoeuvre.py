@@ -16,8 +16,10 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   skateboard has none: it coasts on, four-leg balancing).
 
 Targets beyond the library's range are clamped to it. On top of the trajectory the command
-sets the deck roll (the skateboard's ``board_roll`` and ``board_roll_rate``, held over the
-horizon at the commanded rate) when it commands one, and moves the rider's pose, sway and
+sets the deck roll (the skateboard's ``board_roll`` and ``board_roll_rate``) over the
+horizon when it commands one: the command's own timeline where the ride's commands are
+planned ahead (the rider's ``command_preview``), else the present command extrapolated at
+its rate, and moves the rider's pose, sway and
 forces to the balance of that roll (:mod:`ridempc.mpc.statics`).
 """
 
@@ -180,35 +182,43 @@ class ManoeuvreSelector:
         return now - t_match
 
     @staticmethod
-    def commands_roll(names: dict[str, int], command: Command, roll_rate: float) -> bool:
-        """Whether the command sets a deck roll the reference has."""
-        return "board_roll" in names and (command.roll != 0.0 or roll_rate != 0.0)
+    def commands_roll(names: dict[str, int], roll: Array) -> bool:
+        """Whether the commanded deck roll over the horizon, ``roll`` [rad], sets a roll the
+        reference has (a pair with a ``board_roll`` state, a roll that is not all zero)."""
+        return "board_roll" in names and bool(np.any(np.asarray(roll) != 0.0))
 
     @classmethod
     def with_command(
         cls,
         problem: MpcProblem,
         names: dict[str, int],
-        command: Command,
-        roll_rate: float,
+        roll: Array,
         balance: StaticShift | None = None,
     ) -> MpcProblem:
         """The problem with the commanded deck roll laid over the reference (if it has one),
         and with ``balance``, the reference's change per radian of roll and per rad/s of
         roll rate (:meth:`~ridempc.mpc.controller.LinearMpc.static_shift`), moved to stay
-        in balance."""
-        if not cls.commands_roll(names, command, roll_rate):
+        in balance.
+
+        Args:
+            problem: The tick's problem.
+            names: State indices by name.
+            roll: Commanded deck roll at each of the horizon's nodes [rad]; its rate [rad/s]
+                is the central difference over the nodes' step.
+            balance: The static shift, or None to lay the roll over the reference alone.
+        """
+        if not cls.commands_roll(names, roll):
             return problem
         states = problem.state_reference.copy()
         inputs = problem.input_reference.copy()
-        k = np.arange(states.shape[0])
-        roll = names["board_roll"]
-        wanted = command.roll + roll_rate * k * problem.dt
+        wanted = np.broadcast_to(np.asarray(roll, dtype=float), (states.shape[0],))
+        rate = np.gradient(wanted, problem.dt) if wanted.size > 1 else np.zeros(1)
+        index = names["board_roll"]
         if balance is not None:
-            change = wanted - states[:, roll]
-            states += np.outer(change, balance.states) + roll_rate * balance.velocities
+            change = wanted - states[:, index]
+            states += np.outer(change, balance.states) + np.outer(rate, balance.velocities)
             inputs += np.outer(change[:-1], balance.inputs)
-        states[:, roll] = wanted
+        states[:, index] = wanted
         if "board_roll_rate" in names:
-            states[:, names["board_roll_rate"]] = roll_rate
+            states[:, names["board_roll_rate"]] = rate
         return replace(problem, state_reference=states, input_reference=inputs)

@@ -230,11 +230,11 @@ class MpcRider(Controller):
         t_ref = self.manoeuvre.reference_time(now)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
-        names, roll_rate = self.layout.names, self._roll_rate(command, now)
+        names, roll = self.layout.names, self._roll_horizon(command, now, problem)
         balance = None
-        if self.selector.commands_roll(names, command, roll_rate):
+        if self.selector.commands_roll(names, roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
-        problem = self.selector.with_command(problem, names, command, roll_rate, balance)
+        problem = self.selector.with_command(problem, names, roll, balance)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem
@@ -249,12 +249,21 @@ class MpcRider(Controller):
             mpc_iterations=float(plan.iterations),
         )
 
-    def _roll_rate(self, command: Command, now: float) -> float:
+    def _roll_horizon(self, command: Command, now: float, problem: MpcProblem) -> Array:
+        """The commanded deck roll at the horizon's nodes [rad]: read ahead from the
+        ``command_preview`` when the ride's commands are planned, else the present command
+        extrapolated at its rate (a backward difference over the last MPC step), which
+        tracks a moving command one step late."""
+        nodes = problem.state_reference.shape[0]
+        times = now + problem.dt * np.arange(nodes)
+        if self.command_preview is not None:
+            return np.array([self.command_preview(float(t)).roll for t in times])
         previous = self._command_roll
         self._command_roll = (now, command.roll)
-        if previous is None or now <= previous[0]:
-            return 0.0
-        return (command.roll - previous[1]) / (now - previous[0])
+        rate = 0.0
+        if previous is not None and now > previous[0]:
+            rate = (command.roll - previous[1]) / (now - previous[0])
+        return np.asarray(command.roll + rate * (times - now), dtype=float)
 
     def _speed(self, estimate: EstimatedState) -> float:
         if estimate.boards:

@@ -123,6 +123,7 @@ class Simulation:
         self.driver: MotorDriver | None = None
         if robot is not None and controller is not None:
             self.control_rate = Rate.of(controller.rate_hz, hz, "controller")
+            controller.command_preview = scenario.command_at  # the planned command timeline
             self.sensors = SensorSuite(
                 scene.model,
                 encoder_joints=robot.encoder_joints,
