@@ -24,9 +24,12 @@ import pinocchio as pin
 import pytest
 import qpsolvers
 
+from ridempc.boards import load_board
+from ridempc.boards.board import Board
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, RidempcError
 from ridempc.estimation import BoardEstimate, EstimatedState, StateEstimator
+from ridempc.mpc.rider import platform_feet, rolling_platforms
 from ridempc.robots import load_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command, Disturbance, Scenario
@@ -47,6 +50,7 @@ from ridempc.wbc import (
     to_motor_command,
 )
 from ridempc.wbc.contacts import platform_rotation
+from ridempc.wbc.platforms import RollingPlatform
 
 GRAVITY = 9.81
 Springs = Literal["passive", "rigid"]
@@ -239,23 +243,31 @@ def test_site_forces_set_the_centre_of_pressure_along_a_foot() -> None:
         wbc.solve(_state(wbc, q, v), replace(base, site_forces=sites[:2]))
 
 
-def test_sites_on_a_turning_tilted_board_move_with_it() -> None:
-    """Feet on a board estimate take its deck's normal for their friction pyramids and
-    accelerate with it, :math:`a = a_P + \\omega \\times (\\omega \\times r)`."""
-    robot = load_robot("cyberdog2")
-    wbc = WholeBodyController(robot)
-    estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
-    q, v = _standing(robot, estimator, np.random.default_rng(17))
+def _on_a_board(
+    wbc: WholeBodyController, seed: int, yaw: float, pitch: float, roll: float, yaw_rate: float
+) -> tuple[np.ndarray, np.ndarray, Any, BoardEstimate]:
+    """A random standing configuration, every foot on one board platform centred under
+    the sites, the platform at the given attitude [rad] and yaw rate [rad/s]."""
+    estimator = StateEstimator(wbc.robot, pinocchio=wbc.model.pinocchio)
+    q, v = _standing(wbc.robot, estimator, np.random.default_rng(seed))
     terms = wbc.model.update(q, v)
     board = BoardEstimate(
         feet=wbc.foot_names,
         position=terms.sites.position.mean(axis=0),
-        yaw=0.3,
-        pitch=0.05,
-        roll=-0.1,
+        yaw=yaw,
+        pitch=pitch,
+        roll=roll,
         velocity=np.array([1.0, 0.0, 0.0]),
-        yaw_rate=1.5,
+        yaw_rate=yaw_rate,
     )
+    return q, v, terms, board
+
+
+def test_sites_on_a_turning_tilted_board_move_with_it() -> None:
+    """Feet on a board estimate take its deck's normal for their friction pyramids and
+    accelerate with it, :math:`a = a_P + \\omega \\times (\\omega \\times r)`."""
+    wbc = WholeBodyController(load_robot("cyberdog2"))
+    q, v, terms, board = _on_a_board(wbc, 17, yaw=0.3, pitch=0.05, roll=-0.1, yaw_rate=1.5)
     state = replace(_state(wbc, q, v), boards=(board,))
     feet = len(wbc.foot_names)
     base = _targets(wbc, q, v, np.ones(feet, dtype=bool))
@@ -271,6 +283,31 @@ def test_sites_on_a_turning_tilted_board_move_with_it() -> None:
     mu = wbc.settings.friction
     assert np.all(local[:, 2] > 0.0)
     assert np.all(np.abs(local[:, :2]) <= mu * local[:, 2:3] + 1e-6)
+
+
+def test_feet_on_a_rolling_shoe_move_it_with_their_push() -> None:
+    """On a platform that rolls freely along its heading (a Hovershoe), each site
+    accelerates with the shoe, :math:`a = a^0 + (c_4 \\theta - e_x^\\top \\sum f) / m_s\\,
+    e_x`: across the heading and vertically as on a still support; a push on a rigid
+    support moves nothing."""
+    robot = load_robot("cyberdog2")
+    shoe = RollingPlatform(mass=2.7, drive=447.0)
+    wbc = WholeBodyController(robot, platforms=(shoe,))
+    q, v, terms, board = _on_a_board(wbc, 5, yaw=0.4, pitch=0.02, roll=0.0, yaw_rate=0.0)
+    state = replace(_state(wbc, q, v), boards=(board,))
+    targets = _targets(wbc, q, v, np.ones(len(wbc.foot_names), dtype=bool))
+    out = wbc.solve(state, targets)
+    heading = np.array([np.cos(board.yaw), np.sin(board.yaw), 0.0])
+    push = heading @ out.site_forces.sum(axis=0)
+    assert abs(push) > 0.1  # [N] the QP does push (its CoM target is off-centre)
+    along = (shoe.drive * board.pitch - push) / shoe.mass
+    achieved = terms.sites.jacobian @ out.acceleration + terms.sites.drift
+    np.testing.assert_allclose(
+        achieved, np.outer(np.full(len(achieved), along), heading), atol=1e-5
+    )
+    rigid = WholeBodyController(robot).solve(state, targets)
+    still = terms.sites.jacobian @ rigid.acceleration + terms.sites.drift
+    np.testing.assert_allclose(still, 0.0, atol=1e-6)
 
 
 def _cost(problem: QpProblem, x: np.ndarray) -> float:
@@ -444,14 +481,28 @@ def test_cassie_loops_stay_closed(springs: Springs) -> None:
 class WbcStand(Controller):
     """Test-only: hold the starting centre of mass and base orientation, every foot down,
     through the whole-body QP; the low-level PD about its joint targets at a tenth of each
-    motor's default gains."""
+    motor's default gains. On a board, the feet on each platform are estimated as the
+    MPC rider does, and the WBC knows how a rolling platform moves (unless ``rolling`` is
+    False)."""
 
     rate_hz = 500.0
 
-    def __init__(self, robot: Robot, settings: WbcSettings) -> None:
-        super().__init__(robot, "none")
-        self.estimator = StateEstimator(robot)
-        self.wbc = WholeBodyController(robot, settings, pinocchio=self.estimator.pinocchio)
+    def __init__(
+        self, robot: Robot, settings: WbcSettings, board: Board | None = None, rolling: bool = True
+    ) -> None:
+        super().__init__(robot, "none" if board is None else board.name)
+        platforms = 1 if board is None else len(board.params.platform_sites)
+        self.estimator = StateEstimator(
+            robot,
+            platforms=platform_feet(robot, platforms) if board is not None else (),
+            support_height=board.platform_top if board is not None else 0.0,
+        )
+        self.wbc = WholeBodyController(
+            robot,
+            settings,
+            pinocchio=self.estimator.pinocchio,
+            platforms=rolling_platforms(board) if rolling else (),
+        )
         self.kp = 0.1 * np.array([m.kp for m in robot.motors])
         self.kd = 0.1 * np.array([m.kd for m in robot.motors])
         self.targets: WbcTargets | None = None
@@ -519,3 +570,20 @@ def test_wbc_holds_the_robot_through_pushes(robot) -> None:
         f"max {iterations.max()}); drift final {1e3 * drift[-1]:.1f} mm, "
         f"max {1e3 * np.max(drift):.1f} mm"
     )
+
+
+def test_the_wbc_alone_stands_on_the_hovershoes_knowing_they_roll() -> None:
+    """Holding its starting centre of mass on the Hovershoes, the WBC stands while it knows
+    that its push rolls the 2.7 kg shoes (:mod:`ridempc.wbc.platforms`); taking them for
+    ground it pushed them away (both ran off at 3.8 m/s and the rider fell in 0.4 s)."""
+    robot, board = load_robot("cassie"), load_board("hovershoes")
+    scenario = Scenario(name="wbc-hovershoes", duration=1.5)
+    ends = {}
+    for rolling in (True, False):
+        controller = WbcStand(robot, CLOSED_LOOP_SETTINGS["cassie"], board, rolling)
+        scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board)
+        result = Simulation(scene, controller, scenario).run()
+        speed = np.abs(result.log["board_velocity"][:, :, 0]).max()
+        ends[rolling] = (result.status, speed)
+    assert ends[True][0] == "ok" and ends[True][1] < 0.6, ends  # [m/s] (0.46 measured)
+    assert ends[False][0] != "ok" or ends[False][1] > 1.0, ends

@@ -32,6 +32,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.board import Board
+from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -47,12 +49,14 @@ from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
+from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
+from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.settings import WbcSettings
 
-__all__ = ["MpcRider"]
+__all__ = ["MpcRider", "platform_feet", "rolling_platforms"]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
@@ -65,12 +69,23 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 WBC_GRACE_TICKS: int = 5
 
 
-def _platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
+def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
     """Feet per platform: one each when the board has a platform per foot, else all on one."""
     feet = robot.params.foot_bodies
     if platforms == len(feet):
         return tuple((foot,) for foot in feet)
     return (feet,)
+
+
+def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
+    """The platforms that the rider's push moves, as the WBC sees them: each Hovershoe, the
+    bare shoe with its identified drive (:mod:`ridempc.wbc.platforms`); none otherwise."""
+    if board is None or not isinstance(board.params, HovershoesParameters):
+        return ()
+    shoes = wheeled_board(board)
+    assert isinstance(shoes, HovershoesBoard)
+    shoe = RollingPlatform(mass=shoes.shoe_mass, drive=shoes.reduced.c4)
+    return (shoe,) * shoes.n_platforms
 
 
 class MpcRider(Controller):
@@ -95,7 +110,7 @@ class MpcRider(Controller):
         self.pair = load_mpc_pair(robot.name, board)
         loaded = load_board(board)
         n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
-        self.platform_feet = _platform_feet(robot, n_platforms)
+        self.platform_feet = platform_feet(robot, n_platforms)
         self.estimator = StateEstimator(
             robot,
             platforms=self.platform_feet,
@@ -122,7 +137,12 @@ class MpcRider(Controller):
         # roll-tracking: roll RMSE 0.063 rad at 1, 0.048 at 100; 1000 lost the QP).
         sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
         settings_wbc = WbcSettings(springs="rigid" if sprung else "passive", force_weight=100.0)
-        self.wbc = WholeBodyController(robot, settings_wbc, pinocchio=self.pinocchio)
+        self.wbc = WholeBodyController(
+            robot,
+            settings_wbc,
+            pinocchio=self.pinocchio,
+            platforms=rolling_platforms(loaded),
+        )
         self.kp = np.array([m.kp for m in robot.motors])
         self.kd = np.array([m.kd for m in robot.motors])
         self._contact_foot = self._contacts_to_feet(reference.contact_names)

@@ -180,7 +180,9 @@ class ClosedChainConstraint(Constraint):
 
 class ContactAccelerationConstraint(Constraint):
     """Sites in contact move with their support: :math:`E_s (J_s \\ddot q + \\dot J_s v) =
-    E_s a_s^*` [m/s^2], :math:`a_s^*` from :mod:`ridempc.wbc.contacts`.
+    E_s a_s^*` [m/s^2], :math:`a_s^*` from :mod:`ridempc.wbc.contacts`; on a support that the
+    forces move, :math:`a_s^* = a_s + \\sum_j K_{sj} f_j`, so the rows read
+    :math:`E_s (J_s \\ddot q - \\sum_j K_{sj} f_j) = E_s (a_s - \\dot J_s v)`.
 
     A foot's first site is held in all three directions (:math:`E_s = I`). A line foot's
     second site is held only across the line joining the two,
@@ -222,6 +224,13 @@ class ContactAccelerationConstraint(Constraint):
             basis = self._basis @ terms.site_rotation[second].transpose(0, 2, 1)  # E_s, world
             matrix[split:, :nv] = (basis @ sites.jacobian[second]).reshape(-1, nv)
             b[split:] = (basis @ wanted[second][:, :, None]).ravel()
+        if contacts.coupling is not None:  # a* = a + K f: the forces' part moves left
+            coupling = contacts.coupling.reshape(len(contacts.active), 3, -1)
+            matrix[:split, self.layout.force] = -coupling[first].reshape(split, -1)
+            if second.size:
+                matrix[split:, self.layout.force] = -(basis @ coupling[second]).reshape(
+                    -1, coupling.shape[-1]
+                )
         active = contacts.active[self._row_site]
         return LinearConstraint(matrix, np.where(active, b, -INF), np.where(active, b, INF))
 

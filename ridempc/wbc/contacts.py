@@ -15,25 +15,31 @@ A site is *active* when its foot is planned in contact. It then stays on its sup
   unknown), :math:`\\omega_P = (0, 0, \\dot\\psi)` [rad/s] the estimate's yaw rate (the
   estimator does not report roll and pitch rates) and :math:`o_P` its origin [m]. The
   tangential (Euler) term :math:`\\dot\\omega_P \\times r` is left out: it is not estimated.
+
+  A platform that the rider's own push moves (a Hovershoe, :mod:`ridempc.wbc.platforms`)
+  adds its response: :math:`a^* = a^0 + K f`, affine in the forces :math:`f` on the
+  platform's sites, so the contact rows of the QP hold forces as well as accelerations.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.estimation.state import BoardEstimate
 from ridempc.wbc.model import ModelTerms
+from ridempc.wbc.platforms import RollingPlatform
 
 __all__ = ["ContactSet", "build_contact_set", "platform_rotation"]
 
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 _AXES = np.eye(3)
+_XYZ = np.arange(3)
 
 
 def platform_rotation(board: BoardEstimate) -> Array:
@@ -59,12 +65,16 @@ class ContactSet:
         frame: Each site's support axes as rows :math:`(t_1, t_2, n)` [-], shape
             (sites, 3, 3): two tangents and the normal.
         acceleration: Wanted acceleration of each active site :math:`a^*` [m/s^2],
-            shape (sites, 3).
+            shape (sites, 3), where no force moves the support.
+        coupling: :math:`K` [1/kg], the part of :math:`a^*` that the forces on the robot
+            at the sites add, :math:`a^*_i \\mathrel{+}= \\sum_j K_{ij} f_j`, shape
+            (sites, 3, sites, 3); None where every support is rigid.
     """
 
     active: NDArray[np.bool_]
     frame: Array
     acceleration: Array
+    coupling: Array | None = None
 
     @property
     def normal(self) -> Array:
@@ -90,6 +100,7 @@ def build_contact_set(
     contact: NDArray[np.bool_],
     boards: Sequence[BoardEstimate] = (),
     board_acceleration: Sequence[Array] = (),
+    platforms: Sequence[RollingPlatform | None] = (),
 ) -> ContactSet:
     """Normals, tangents and wanted accelerations of the contact sites.
 
@@ -100,6 +111,7 @@ def build_contact_set(
         contact: Planned contact per foot.
         boards: The estimator's board platforms (empty on the ground).
         board_acceleration: Acceleration of each platform's origin [m/s^2] (zero if missing).
+        platforms: Per board, how the rider's forces move it (None or missing: they do not).
     """
     active = np.asarray(contact, dtype=bool)[site_foot]
     contacts = ContactSet.on_ground(active)
@@ -116,4 +128,14 @@ def build_contact_set(
         centripetal = -(board.yaw_rate**2) * lever  # omega x (omega x r), omega along z
         centripetal[:, 2] = 0.0
         contacts.acceleration[sites] = origin_acceleration + centripetal
+        platform = platforms[k] if k < len(platforms) else None
+        if platform is None:
+            continue
+        response = platform.response(board)
+        contacts.acceleration[sites] += response.drift
+        if contacts.coupling is None:
+            n = len(site_foot)
+            contacts = replace(contacts, coupling=np.zeros((n, 3, n, 3)))
+        assert contacts.coupling is not None
+        contacts.coupling[np.ix_(sites, _XYZ, sites, _XYZ)] = response.coupling[None, :, None, :]
     return contacts

@@ -7,7 +7,8 @@ actuators", after the MIT Cheetah's [26]):
    kinematics of the contact sites, base, centre of mass and closed chains at the
    estimated :math:`(q, v)` (Pinocchio);
 2. :func:`~ridempc.wbc.contacts.build_contact_set` places the planned contacts on the
-   ground or on the estimated board platforms;
+   ground or on the estimated board platforms, which move with the rider's push where
+   they roll freely (:mod:`ridempc.wbc.platforms`);
 3. :class:`~ridempc.wbc.qp.WholeBodyQP` builds the QP on
    :math:`z = (\\ddot q, f, \\tau, \\lambda)` from the tasks (base orientation, centre of mass
    or base position, contact forces, swing feet, posture, regularisation) and constraints
@@ -22,6 +23,8 @@ actuators", after the MIT Cheetah's [26]):
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
@@ -43,6 +46,7 @@ from ridempc.wbc.constraints import (
 )
 from ridempc.wbc.contacts import ContactSet, build_contact_set
 from ridempc.wbc.model import WholeBodyModel
+from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import QpProblem, QpSolution, WholeBodyQP
 from ridempc.wbc.settings import WbcSettings
 from ridempc.wbc.targets import WbcOutput, WbcTargets
@@ -78,6 +82,9 @@ class WholeBodyController:
         pinocchio: The robot's Pinocchio model (built from ``robot`` if not given).
         posture: Default nominal posture, motor joint angles [rad] (default: the robot's
             stand keyframe).
+        platforms: Per board platform of the estimate (``EstimatedState.boards`` order), how
+            the rider's forces move it (:mod:`ridempc.wbc.platforms`); None or missing: a
+            rigid support.
 
     Attributes:
         model: The Pinocchio side (:class:`~ridempc.wbc.model.WholeBodyModel`).
@@ -92,8 +99,10 @@ class WholeBodyController:
         settings: WbcSettings | None = None,
         pinocchio: PinocchioRobot | None = None,
         posture: Array | None = None,
+        platforms: Sequence[RollingPlatform | None] = (),
     ) -> None:
         self.robot = robot
+        self.platforms = tuple(platforms)
         self.settings = settings or WbcSettings()
         self.model = WholeBodyModel(robot, pinocchio)
         model = self.model.model
@@ -163,8 +172,12 @@ class WholeBodyController:
         terms = self.model.update(q, rng.normal(size=model.nv))
         feet = len(self.model.foot_names)
         problems = []
+        n_sites = self.model.layout.n_sites
         for standing in (True, False):
-            contacts = ContactSet.on_ground(np.full(self.model.layout.n_sites, standing))
+            contacts = ContactSet.on_ground(np.full(n_sites, standing))
+            if any(p is not None for p in self.platforms):
+                coupling = rng.normal(size=(n_sites, 3, n_sites, 3))
+                contacts = replace(contacts, coupling=coupling)
             for s in range(self.model.layout.n_sites):
                 contacts.frame[s] = pin.exp3(0.3 * rng.normal(size=3)).T
             targets = WbcTargets(
@@ -212,6 +225,7 @@ class WholeBodyController:
             targets.contact,
             state.boards,
             targets.board_acceleration,
+            self.platforms,
         )
         problem = self.qp.build(terms, targets, contacts)
         build_time = time.perf_counter()
