@@ -31,6 +31,7 @@ import pytest
 
 from ridempc.boards import load_board
 from ridempc.controllers import StandController, make_controller
+from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatorParameters, StateEstimator, estimate_board
 from ridempc.estimation.imu import GRAVITY, ImuMount
 from ridempc.estimation.leg_odometry import LegOdometryModel
@@ -349,6 +350,14 @@ def test_feet_on_a_platform_get_a_board_estimate() -> None:
     assert abs(board.roll) < 0.02 and abs(board.pitch) < 0.02  # standing on flat ground
     assert board.position[2] == pytest.approx(0.019, abs=0.01)  # the ball feet's centres
     assert np.linalg.norm(board.velocity) < 0.05
+    # a foot put on the ground (a push-off) leaves the board's estimate, then comes back
+    estimator.set_support(["RL_foot"])
+    state = estimator.update(controller.packets[-1])
+    assert state.board is not None and state.board.feet == ("FL_foot", "FR_foot", "RR_foot")
+    estimator.set_support([])
+    assert estimator.update(controller.packets[-1]).board.feet == feet
+    with pytest.raises(ConfigError, match="'RL_paw' is not a foot"):
+        estimator.set_support(["RL_paw"])
 
 
 def test_filter_model_shapes_and_symmetry() -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -15,6 +16,7 @@ from ridempc.scenarios import resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
+from ridempc.trajopt.schedule import Contact
 from ridempc.wbc.qp import WbcFailed
 
 
@@ -99,3 +101,39 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     blind = rider._roll_horizon(scenario.command_at(now), now, problem)
     assert blind[0] == pytest.approx(wanted[0])
     assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend
+
+
+def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> None:
+    """The schedule's swing foot gets a swing target from the plan's joint angles, and
+    while it pushes it stands on the ground: out of the deck's estimate, not a fall."""
+    rider = MpcRider(dog, "skateboard")
+    scenario = resolve_scenario("push-off-0.7", "skateboard").with_duration(1.8)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    seen: list[tuple[float, tuple, tuple[str, ...], bool]] = []
+    solve = rider.wbc.solve
+
+    def recording(state, targets):
+        seen.append(
+            (state.time, rider._support, state.boards[0].feet, targets.swing_position is not None)
+        )
+        return solve(state, targets)
+
+    rider.wbc.solve = recording
+    result = Simulation(scene, rider, scenario).run()
+    assert result.status == "ok", result.fall_reason
+    pusher = dog.params.foot_bodies.index("RL_foot")
+    swinging = [s for s in seen if s[1] is not None and s[1][pusher] is Contact.SWING]
+    pushing = [s for s in seen if s[1] is not None and s[1][pusher] is Contact.GROUND]
+    assert swinging and pushing  # the schedule reaches the push within the ride
+    assert all(s[3] for s in swinging)  # a swing target while it swings
+    # the deck is read off the other feet from the tick after the MPC step that set it
+    assert all("RL_foot" not in s[2] for s in pushing[1:])
+    assert all(s[2] == dog.params.foot_bodies for s in seen if s[0] < 0.5)  # at rest: all
+    site = scene.model.site("RL_contact")
+    heights = []
+    for qpos in result.log["qpos"]:
+        scene_data = mujoco.MjData(scene.model)
+        scene_data.qpos[: qpos.size] = qpos
+        mujoco.mj_kinematics(scene.model, scene_data)
+        heights.append(scene_data.site_xpos[site.id][2])
+    assert min(heights) < 0.03  # [m] the foot reached the ground (the deck is 0.11 m up)

@@ -17,7 +17,8 @@ Each tick, from one :class:`~ridempc.sim.sensors.SensorPacket` (never its ``trut
    (:mod:`~ridempc.estimation.history`).
 6. **Board** (:mod:`~ridempc.estimation.board`): when told which feet stand on a board,
    each platform's pose and velocity from those of its feet in contact (from all of them
-   when none is).
+   when none is); a foot the controller puts on the ground (:meth:`set_support`, a push-off)
+   stands still and is left out.
 
 Orientation comes from the IMU alone: the simulated IMU's orientation error is white,
 with no drift to correct, so the VIO's yaw is not used.
@@ -102,7 +103,8 @@ class StateEstimator:
         if len(set(on_board)) != len(on_board):
             raise ConfigError(f"a foot stands on two platforms: {[list(g) for g in platforms]}")
         self.platforms = tuple(tuple(group) for group in platforms if group)
-        self._on_ground = np.array([f not in on_board for f in feet])
+        self._on_board = np.array([f in on_board for f in feet])
+        self._on_ground = ~self._on_board
         self._platform_sites = tuple(
             np.isin(self.legs.site_foot, [feet.index(f) for f in group]) for group in self.platforms
         )
@@ -118,6 +120,20 @@ class StateEstimator:
         self._vio_stamp: float | None = None
         self.state: EstimatedState | None = None
         self.rejected_feet = 0  # stance-foot velocities left out as outliers, since reset
+
+    def set_support(self, on_ground: Sequence[str]) -> None:
+        """Which of the platforms' feet stand on the ground now instead of their board (a
+        skateboard push-off); the rest stand on their boards again. A foot on the ground
+        has a still support and says nothing of its board's pose.
+
+        Raises:
+            ConfigError: A name is not a foot.
+        """
+        feet = self.legs.names
+        unknown = [f for f in on_ground if f not in feet]
+        if unknown:
+            raise ConfigError(f"support: '{unknown[0]}' is not a foot (valid: {', '.join(feet)})")
+        self._on_ground = ~self._on_board | np.isin(feet, list(on_ground))
 
     def _sense(self, packet: SensorPacket) -> tuple[BaseAttitude, Array, Array, LegReading]:
         """Steps 1-3: attitude, joints and legs of one packet."""
@@ -248,12 +264,17 @@ class StateEstimator:
         v[:3] = attitude.rotation.T @ base_velocity
         feet = np.array([x[self.odometry.foot_position(i)] for i in range(len(self.legs.feet))])
         boards = []
-        stance_sites = stance[self.legs.site_foot]
+        on_board = stance & ~self._on_ground  # the feet that say where a board is
+        stance_sites = on_board[self.legs.site_foot]
         names = self.legs.names
+        board_sites = (~self._on_ground)[self.legs.site_foot]
         for group, sites in zip(self.platforms, self._platform_sites, strict=True):
             if np.any(sites & stance_sites):  # the feet in the air say nothing of the board
                 sites = sites & stance_sites
-                group = tuple(f for f in group if stance[names.index(f)])
+                group = tuple(f for f in group if on_board[names.index(f)])
+            elif np.any(sites & board_sites):  # none in contact: all those on the board
+                sites = sites & board_sites
+                group = tuple(f for f in group if not self._on_ground[names.index(f)])
             boards.append(
                 estimate_board(
                     group,

@@ -11,9 +11,12 @@ Every 2 ms (500 Hz) the rider
    trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
-   the Z-Y-X angles, the first input's contact forces (summed per foot), and, for a foot
-   the schedule lifts, a swing target; and solves the 500 Hz whole-body QP
-   (:class:`~ridempc.wbc.WholeBodyController`);
+   the Z-Y-X angles, the first input's contact forces (summed per foot), the feet in
+   contact as the schedule has them over the step, and, for a foot the schedule lifts, a
+   swing target where the plan's joint angles put it (forward kinematics at the estimated
+   base pose); and solves the 500 Hz whole-body QP
+   (:class:`~ridempc.wbc.WholeBodyController`). A foot the schedule puts on the ground (a
+   push-off) stands on the ground for the WBC and the estimator, not on the board;
 4. sends the QP's torques as feedforward with its joint targets to the motor PD.
 
 **Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
@@ -51,6 +54,7 @@ from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.trajopt.rotations import euler_zyx_matrix
+from ridempc.trajopt.schedule import Contact
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
 from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import WbcFailed
@@ -149,6 +153,13 @@ class MpcRider(Controller):
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
+        model = self.pinocchio.model
+        self._plan_joints = [
+            (i, model.joints[model.getJointId(name[2:])].idx_q)
+            for i, name in enumerate(reference.state_names)
+            if name.startswith("q_")
+        ]
+        self._support: tuple[Contact, ...] | None = None  # per foot, this MPC step
         self._tick = 0
         self._plan: Plan | None = None
         self._last_problem: MpcProblem | None = None
@@ -263,11 +274,27 @@ class MpcRider(Controller):
         if not np.all(np.isfinite(plan.states)):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
         self._plan, self._plan_time = plan, now
+        self._set_support(self.mpc.reference.sample(t_ref, 1, self.mpc.settings.dt).contacts[0])
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
+
+    def _set_support(self, contacts: tuple[Contact, ...]) -> None:
+        """Where each foot is over this MPC step, from the schedule's contacts: on the ground
+        if any of its contacts is, in the air if all swing, else on its board. The
+        estimator is told which feet stand on the ground (they say nothing of the board)."""
+        feet = self.robot.params.foot_bodies
+        support = [Contact.SWING] * len(feet)
+        for contact, foot in zip(contacts, self._contact_foot, strict=True):
+            if contact is Contact.GROUND or support[foot] is Contact.GROUND:
+                support[foot] = Contact.GROUND
+            elif contact is Contact.BOARD:
+                support[foot] = Contact.BOARD
+        self._support = tuple(support)
+        ground = [f for f, c in zip(feet, support, strict=True) if c is Contact.GROUND]
+        self.estimator.set_support(ground)
 
     def _roll_horizon(self, command: Command, now: float, problem: MpcProblem) -> Array:
         """The commanded deck roll at the horizon's nodes [rad]: read ahead from the
@@ -315,6 +342,14 @@ class MpcRider(Controller):
             site_forces[i] = f
             forces[foot] += f
             contact[foot] |= bool(f[2] > 1e-3)
+        swing = None
+        if self._support is not None:
+            contact = np.array([c is not Contact.SWING for c in self._support])
+            if not contact.all():  # swing feet go where the plan's joint angles put them
+                q = estimate.q.copy()
+                for i, index in self._plan_joints:
+                    q[index] = x[i]
+                swing = self.wbc.model.foot_points(q)
         if not contact.any():
             contact[:] = True
         targets = WbcTargets(
@@ -325,6 +360,7 @@ class MpcRider(Controller):
             velocity=velocity,
             angular_velocity=rotation @ omega_body,
             site_forces=site_forces if self._sites_match else None,
+            swing_position=swing,
         )
         out = self.wbc.solve(estimate, targets)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)

@@ -3,7 +3,8 @@
 The rider fell when its base is below ``fall_height`` [m] over its starting support, or when
 one of its bodies that is not a foot touches the ground (for a dead weight: any of it).
 The board fell when one of its bodies other than the wheels touches the ground. On a board,
-a rider's foot on the ground is a fall too: it stepped off.
+a rider's foot on the ground is a fall too (it stepped off), unless the ride puts a foot
+there on purpose (a skateboard push-off, ``feet_on_ground``).
 """
 
 from __future__ import annotations
@@ -16,14 +17,18 @@ __all__ = ["FallDetector"]
 
 
 class FallDetector:
-    def __init__(self, scene: Scene) -> None:
+    """Judges falls on ``scene``; with ``feet_on_ground`` a rider's feet may touch the
+    ground even on a board (a push-off)."""
+
+    def __init__(self, scene: Scene, feet_on_ground: bool = False) -> None:
         model = scene.model
         self._base = scene.base_body
         robot = scene.robot
         self._fall_height = (
             scene.support_height + robot.params.fall_height if robot is not None else None
         )
-        allowed = frozenset() if scene.board is not None else scene.foot_bodies
+        on_board = scene.board is not None and not feet_on_ground
+        allowed = frozenset() if on_board else scene.foot_bodies
         self._forbidden = {b: "rider" for b in scene.rider_bodies - allowed} | {
             b: "board" for b in scene.board_bodies - scene.board_ground_bodies
         }

@@ -144,7 +144,7 @@ class Simulation:
             io.bind(scene.data)
             self.firmware = scene.board.firmware(io)
             self.firmware_rate = Rate.of(self.firmware.rate_hz, hz, "board firmware")
-        self.falls = FallDetector(scene)
+        self.falls = FallDetector(scene, feet_on_ground=scenario.push_off is not None)
         # a controller with an estimator gets its estimate logged next to the truth
         self._logs_estimate = (
             controller is not None and type(controller).estimate is not Controller.estimate

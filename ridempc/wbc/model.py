@@ -136,6 +136,7 @@ class WholeBodyModel:
             self.model, self.pinocchio.constraints, np.zeros(0, dtype=np.int64)
         )
         self.data: pin.Data = self.model.createData()
+        self._points_data: pin.Data = self.model.createData()  # for foot_points
         self.legs = LegKinematics.build(robot, self.pinocchio)
         model = self.model
         motor_v = []
@@ -236,6 +237,19 @@ class WholeBodyModel:
     @property
     def foot_names(self) -> tuple[str, ...]:
         return self.legs.names
+
+    def foot_points(self, q: Array) -> Array:
+        """Each foot's point (the mean of its contact sites) in the world at configuration
+        ``q`` [m], shape (feet, 3): where a swing target puts the foot."""
+        model, data = self.model, self._points_data
+        pin.framesForwardKinematics(model, data, np.asarray(q, dtype=float))
+        sites = np.array([data.oMf[f].translation for f in self.site_frames])
+        feet = self.legs.site_foot
+        count = np.bincount(feet, minlength=len(self.foot_names))[:, None]
+        return np.asarray(
+            np.stack([np.bincount(feet, sites[:, k], len(self.foot_names)) for k in range(3)], 1)
+            / count
+        )
 
     def passive_torque(self, q: Array, v: Array) -> Array:
         """:math:`\\tau_p = -K (q - q_{ref}) - D v` [N m] (springs and joint damping)."""
