@@ -209,6 +209,7 @@ class LinearMpc:
             constraint_upper=g_hi,
             dt=s.dt,
             terminal_weights=s.terminal_factor * self.state_weights,
+            contacts=window.contacts,
         )
 
     def static_shift(self, t: float, changed: int, rider_states: Sequence[int]) -> StaticShift:

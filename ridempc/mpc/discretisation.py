@@ -25,9 +25,19 @@ def zero_order_hold(a_c: Array, dt: float) -> tuple[Array, Array]:
     top block row of the exponential of the augmented matrix (module docstring): the
     discrete :math:`B_k = \\Phi B^c_k` and :math:`g_k = \\Phi f_k`, computed on nx x nx
     blocks only (small enough for BLAS to stay single-threaded, which on a busy machine
-    is ten times faster than SciPy's ``expm`` of the (nx + nu + 1)-square matrix).
+    is ten times faster than SciPy's ``expm`` of the (nx + nu + 1)-square matrix). Equal
+    matrices in the stack are computed once.
     """
     a_c = np.asarray(a_c, dtype=float)
+    if a_c.ndim == 3 and len(a_c) > 1:  # a stack: each distinct matrix once (a steady
+        keys = [m.tobytes() for m in a_c]  # reference repeats one over the horizon)
+        distinct = {key: i for i, key in reversed(list(enumerate(keys)))}
+        if len(distinct) < len(a_c):
+            first = list(distinct.values())
+            exponential, phi = zero_order_hold(a_c[first], dt)
+            where = {key: j for j, key in enumerate(distinct)}
+            pick = [where[key] for key in keys]
+            return exponential[pick], phi[pick]
     eye = np.eye(a_c.shape[-1])
     norm = float(np.max(np.abs(a_c).sum(axis=-2))) * dt if a_c.size else 0.0
     squarings = max(0, int(np.ceil(np.log2(norm / 0.5)))) if norm > 0.5 else 0

@@ -75,13 +75,17 @@ def friction_pyramids(
     upper = np.zeros((n, rows))
     local = _TANGENT.copy()
     local[:, 2] += friction * _NORMAL  # rows on phi: (phi_z, phi_x - mu phi_z, ...)
-    for k, contacts in enumerate(schedule):
-        for i, kind in enumerate(contacts):
-            rotation = surfaces[i] if kind is Contact.BOARD else np.eye(3)
-            block = slice(ROWS_PER_CONTACT * i, ROWS_PER_CONTACT * (i + 1))
-            matrix[k, block][:, force_index[i]] = local @ rotation.T  # a^T R^T f
-            lower[k, block.start] = 0.0
-            upper[k, block.start] = 0.0 if kind is Contact.SWING else max_force
+    kinds = np.array([[kind.value for kind in step] for step in schedule]).reshape(n, nc)
+    on_board = kinds == Contact.BOARD.value
+    standing = kinds != Contact.SWING.value
+    for i in range(nc):
+        block = slice(ROWS_PER_CONTACT * i, ROWS_PER_CONTACT * (i + 1))
+        board_rows = local @ np.asarray(surfaces[i]).T  # a^T R^T f
+        rows_i = np.where(on_board[:, i, None, None], board_rows, local)  # N x 5 x 3
+        for column in range(3):
+            matrix[:, block, force_index[i][column]] = rows_i[:, :, column]
+        lower[:, block.start] = 0.0
+        upper[:, block.start] = np.where(standing[:, i], max_force, 0.0)
     return matrix, lower, upper
 
 

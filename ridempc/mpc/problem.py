@@ -54,6 +54,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.mpc.discretisation import zero_order_hold
+from ridempc.trajopt.schedule import Contact
 
 __all__ = [
     "MPC_STEP",
@@ -286,6 +287,8 @@ class MpcProblem:
         constraint_upper: :math:`g^{hi}_k`, N x m.
         dt: Step :math:`\\Delta t` [s].
         terminal_weights: Diagonal of :math:`Q_N` (nx); default :math:`Q`.
+        contacts: Per step, where each contact is (the schedule the bounds come from);
+            empty when not known.
     """
 
     initial_state: Array
@@ -303,6 +306,7 @@ class MpcProblem:
     constraint_upper: Array
     dt: float = MPC_STEP
     terminal_weights: Array | None = None
+    contacts: tuple[tuple[Contact, ...], ...] = ()
 
     def __post_init__(self) -> None:
         a = np.asarray(self.A, dtype=float)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -112,6 +113,11 @@ class MotionReference:
     steady_rates: Array
     metadata: dict[str, Any]
 
+    @cached_property
+    def _input_integral(self) -> Array:
+        """The inputs' running integral at the nodes, (M + 1) x nu."""
+        return np.vstack([np.zeros(self.inputs.shape[1]), np.cumsum(self.inputs * self.dt, 0)])
+
     @property
     def duration(self) -> float:
         """Length of the trajectory [s]."""
@@ -132,18 +138,14 @@ class MotionReference:
         """
         times = np.arange(horizon + 1, dtype=np.float64) * dt + t0
         end = self.times[-1]
-        states = np.column_stack([np.interp(times, self.times, column) for column in self.states.T])
+        states = _interp_rows(times, self.times, self.states)
         states += np.maximum(times - end, 0.0)[:, None] * self.steady_rates
         # Inputs averaged over each step: differences of their running integral.
         step = self.dt
-        integral = np.vstack([np.zeros(self.inputs.shape[1]), np.cumsum(self.inputs * step, 0)])
-
-        def running(t: Array) -> Array:
-            inside = np.column_stack([np.interp(t, self.times, c) for c in integral.T])
-            return inside + np.maximum(t - end, 0.0)[:, None] * self.inputs[-1]
-
         clipped = np.maximum(times, self.times[0])
-        inputs = np.diff(running(clipped), axis=0) / dt
+        running = _interp_rows(clipped, self.times, self._input_integral)
+        running += np.maximum(clipped - end, 0.0)[:, None] * self.inputs[-1]
+        inputs = np.diff(running, axis=0) / dt
         before = times[:-1] < self.times[0]
         inputs[before] = self.inputs[0]
         interval = np.clip(
@@ -158,6 +160,15 @@ class MotionReference:
                     inputs[k, self.force_index[i]] = 0.0
         parameters = self.parameters[interval]
         return ReferenceWindow(times, states, inputs, parameters, contacts)
+
+
+def _interp_rows(t: Array, grid: Array, table: Array) -> Array:
+    """:func:`numpy.interp` of every column of ``table`` (rows on the increasing ``grid``)
+    at the times ``t``, held at the ends; one search for all columns."""
+    upper = np.clip(np.searchsorted(grid, t, side="right"), 1, len(grid) - 1)
+    lower = upper - 1
+    weight = np.clip((t - grid[lower]) / (grid[upper] - grid[lower]), 0.0, 1.0)[:, None]
+    return np.asarray((1.0 - weight) * table[lower] + weight * table[upper])
 
 
 def _phases(path: Path, entry: LibraryEntry, n_contacts: int) -> tuple[Phase, ...]:

@@ -274,7 +274,7 @@ class MpcRider(Controller):
         if not np.all(np.isfinite(plan.states)):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
         self._plan, self._plan_time = plan, now
-        self._set_support(self.mpc.reference.sample(t_ref, 1, self.mpc.settings.dt).contacts[0])
+        self._set_support(problem.contacts[0])
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
             mpc_fallback=float(plan.fallback),
