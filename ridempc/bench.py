@@ -15,8 +15,9 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
 4. **Other solvers.** The same MPC QPs, :math:`\\min \\tfrac12 z^\\top P z` s.t.
    :math:`l \\le A z \\le u`, are handed to each other backend available here: the
    qpsolvers backends (``proxqp``, ``daqp``, ... with equality rows :math:`l = u` as
-   equalities) and HPIPM through CasADi's ``conic`` interface; each is timed from a cold
-   start per problem (no warm start), and its objective compared with OSQP's.
+   equalities) and HPIPM through CasADi's ``conic`` interface (in its stage-wise OCP
+   layout, see :func:`_stage_layout`); each is timed from a cold start per problem (no
+   warm start, only the solve call), and its objective compared with OSQP's.
 
 Times are wall-clock on this machine and vary with its load; the targets are an MPC p99 of
 at most 5 ms and a WBC p99 of at most 1 ms.
@@ -32,6 +33,7 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import NDArray
 
 from ridempc.errors import RidempcError
 from ridempc.io import atomic_write_json
@@ -127,6 +129,7 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
         p, a = qp.matrices(problem)
         lower, upper = qp.bounds(problem)
         data.append((p, a, lower, upper))
+    layout = _stage_layout(qp.horizon, qp.nx, qp.nu, qp.n_constraints)
     reference = []
     for p, a, lower, upper in data:
         qp_osqp = _as_qpsolvers(p, a, lower, upper)
@@ -140,7 +143,7 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
         try:
             for (p, a, lower, upper), best in zip(data, reference, strict=True):
                 if name == "hpipm (casadi)":
-                    z, seconds = _solve_hpipm(p, a, lower, upper)
+                    z, seconds = _solve_hpipm(p, a, lower, upper, layout)
                 else:
                     problem = _as_qpsolvers(p, a, lower, upper)
                     started = time.perf_counter()
@@ -165,25 +168,147 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
     return out
 
 
+# CasADi's HPIPM interface boxes every variable (nbx = nx, nbu = nu) and replaces an
+# infinite bound by a finite one. The QP is scaled (z of order one, see ridempc.mpc.qp), so
+# 1e4 stays inactive; with CasADi's default of 1e8, HPIPM ran into its 100-iteration limit
+# on some of these problems (none with 1e4, which takes about 7 iterations).
+_HPIPM_INF = 1e4
+
+
+@dataclass(frozen=True)
+class _StageLayout:
+    """Where the MPC QP's variables and rows go in the OCP layout of CasADi's HPIPM.
+
+    ``columns[j]`` is the MPC index of stage-wise variable ``j``, ``rows[i]`` the MPC row of
+    HPIPM constraint row ``i``; ``bound_rows[i]`` is an MPC row with the single entry in
+    MPC column ``bound_columns[i]``, passed as a bound on that variable instead.
+    """
+
+    horizon: int
+    nx: int
+    nu: int
+    ng: int
+    columns: NDArray[np.intp]
+    rows: NDArray[np.intp]
+    bound_rows: NDArray[np.intp]
+    bound_columns: NDArray[np.intp]
+
+    @property
+    def options(self) -> dict[str, Any]:
+        """CasADi's ``N``, ``nx``, ``nu``, ``ng`` (per stage 0..N; no input at stage N)."""
+        n = self.horizon
+        return {
+            "N": n,
+            "nx": [self.nx] * (n + 1),
+            "nu": [self.nu] * n + [0],
+            "ng": [self.ng] * n + [0],
+        }
+
+
+def _stage_layout(horizon: int, nx: int, nu: int, m: int) -> _StageLayout:
+    """Reorder the MPC QP (:mod:`ridempc.mpc.qp`) into the OCP layout of CasADi's HPIPM.
+
+    The MPC orders its variables :math:`z = (x_0, \\dots, x_N, u_0, \\dots, u_{N-1})` and
+    its rows as :math:`x_0 = \\hat x_0`, then the dynamics, the input boxes and the
+    friction rows :math:`G_k u_k`, each for steps 0..N-1. HPIPM gets, stage by stage:
+
+    - variables :math:`(x_0, u_0, x_1, u_1, \\dots, x_{N-1}, u_{N-1}, x_N)`;
+    - rows :math:`[\\mathrm{gap}_0, \\mathrm{lincon}_0, \\dots, \\mathrm{gap}_{N-1},
+      \\mathrm{lincon}_{N-1}]`, where :math:`\\mathrm{gap}_k` are the nx dynamics rows of
+      step k, :math:`-A_k x_k - B_k u_k + x_{k+1} = c_k` (scaled as the MPC's rows are:
+      blocks ``A B I`` with a diagonal
+      ``I``, as the interface requires), and :math:`\\mathrm{lincon}_k` the m friction rows
+      :math:`g^{lo}_k \\le G_k u_k \\le g^{hi}_k` (blocks ``C = 0``, ``D = G_k``); no
+      general rows at stage N;
+    - the :math:`x_0` rows and the input boxes, one entry per row, as bounds on the
+      variables (``lbx = ubx`` for :math:`x_0`); the other states are unbounded
+      (:data:`_HPIPM_INF`).
+
+    So ``N = horizon``, ``nx = [nx] * (N + 1)``, ``nu = [nu] * N + [0]`` and
+    ``ng = [m] * N + [0]`` (:attr:`_StageLayout.options`).
+    """
+    n = horizon
+    x_at = np.arange(n + 1)[:, None] * nx + np.arange(nx)  # MPC columns of x_k
+    u_at = (n + 1) * nx + np.arange(n)[:, None] * nu + np.arange(nu)  # of u_k
+    columns = np.concatenate([np.hstack([x_at[:-1], u_at]).ravel(), x_at[-1]])
+    dynamics = nx + np.arange(n)[:, None] * nx + np.arange(nx)
+    boxes = nx + n * nx + np.arange(n)[:, None] * nu + np.arange(nu)
+    friction = nx + n * (nx + nu) + np.arange(n)[:, None] * m + np.arange(m)
+    return _StageLayout(
+        horizon=n,
+        nx=nx,
+        nu=nu,
+        ng=m,
+        columns=columns,
+        rows=np.hstack([dynamics, friction]).ravel(),
+        bound_rows=np.concatenate([np.arange(nx), boxes.ravel()]),
+        bound_columns=np.concatenate([x_at[0], u_at.ravel()]),
+    )
+
+
 def _solve_hpipm(
-    p: sp.csc_matrix, a: sp.csc_matrix, lower: np.ndarray, upper: np.ndarray
+    p: sp.csc_matrix,
+    a: sp.csc_matrix,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    layout: _StageLayout,
 ) -> tuple[np.ndarray | None, float]:
+    """Solve the MPC QP with HPIPM through CasADi's ``conic`` in the OCP layout of
+    :func:`_stage_layout`; the solution in the MPC's order (None if HPIPM fails) and the
+    time of the solve call alone [s] (from a cold start).
+
+    Raises:
+        ValueError: A row meant as a bound is not one positive entry on its variable.
+    """
     import casadi as ca
 
-    hs = ca.DM(p)
-    as_ = ca.DM(a)
+    columns = layout.columns
+    where = np.empty_like(columns)
+    where[columns] = np.arange(len(columns))  # MPC column -> stage-wise position
+    rows = a.tocsr()[layout.bound_rows]
+    if np.any(np.diff(rows.indptr) != 1) or np.any(rows.indices != layout.bound_columns):
+        raise ValueError("HPIPM layout: an x_0 or input-box row is not a single entry")
+    scale = rows.data
+    if np.any(scale <= 0.0):
+        raise ValueError("HPIPM layout: an x_0 or input-box row has a non-positive entry")
+    n = len(columns)
+    lbx, ubx = np.full(n, -np.inf), np.full(n, np.inf)
+    lbx[where[layout.bound_columns]] = lower[layout.bound_rows] / scale
+    ubx[where[layout.bound_columns]] = upper[layout.bound_rows] / scale
+    hessian = ca.DM(p[columns][:, columns].tocsc())
+    constraints = ca.DM(a.tocsr()[layout.rows][:, columns].tocsc())
     solver = ca.conic(
         "hpipm",
         "hpipm",
-        {"h": hs.sparsity(), "a": as_.sparsity()},
-        {"print_problem": False, "hpipm": {"warm_start": False}, "error_on_fail": False},
+        {"h": hessian.sparsity(), "a": constraints.sparsity()},
+        {
+            **layout.options,
+            "inf": _HPIPM_INF,
+            "print_problem": False,
+            "hpipm": {"warm_start": False},
+            "error_on_fail": False,
+        },
     )
-    n = p.shape[0]
+    # Clipped here as well as by the option: the runtime in CasADi's source
+    # (hpipm_runtime.hpp) clips some of these over another vector's length (ubu over
+    # ng_total entries), which would leave infinities in place.
+    arguments = {
+        "h": hessian,
+        "g": np.zeros(n),
+        "a": constraints,
+        "lba": np.clip(lower[layout.rows], -_HPIPM_INF, _HPIPM_INF),
+        "uba": np.clip(upper[layout.rows], -_HPIPM_INF, _HPIPM_INF),
+        "lbx": np.clip(lbx, -_HPIPM_INF, _HPIPM_INF),
+        "ubx": np.clip(ubx, -_HPIPM_INF, _HPIPM_INF),
+    }
     started = time.perf_counter()
-    result = solver(h=hs, g=np.zeros(n), a=as_, lba=lower, uba=upper, lbx=-np.inf, ubx=np.inf)
+    result = solver(**arguments)
     seconds = time.perf_counter() - started
-    ok = solver.stats().get("success", False)
-    return (np.asarray(result["x"]).ravel() if ok else None), seconds
+    if not solver.stats().get("success", False):
+        return None, seconds
+    z = np.empty(n)
+    z[columns] = np.asarray(result["x"]).ravel()
+    return z, seconds
 
 
 def bench_pair(robot: str, board: str, seconds: float = 2.0) -> PairBench:

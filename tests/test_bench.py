@@ -5,11 +5,12 @@ The benchmark itself (timings) is a command, not a test: ``ridempc bench --json 
 
 from __future__ import annotations
 
+import casadi
 import numpy as np
 import pytest
 import qpsolvers
 
-from ridempc.bench import _as_qpsolvers, _objective
+from ridempc.bench import _as_qpsolvers, _objective, _other_solvers, _solve_hpipm, _stage_layout
 from ridempc.cli import main
 from ridempc.mpc.controller import LinearMpc
 
@@ -35,6 +36,41 @@ def test_other_solvers_find_osqps_optimum(solver: str) -> None:
     assert reference.x is not None
     best = _objective(p, reference.x)
     assert _objective(p, z) == pytest.approx(best, rel=1e-3, abs=1e-6)
+
+
+def _off_reference_qp() -> tuple:
+    mpc = LinearMpc.from_library("cyberdog2", "skateboard", "accelerate", 0.3)
+    x0 = mpc.reference.sample(-1.0, 0, 1.0).states[0] + 0.01  # a little off the reference
+    problem = mpc.problem(0.5, x0)
+    return mpc.build_qp(problem, eps_abs=1e-7, eps_rel=1e-7), problem
+
+
+@pytest.mark.skipif(not casadi.has_conic("hpipm"), reason="CasADi without HPIPM")
+def test_hpipm_in_stage_layout_finds_osqps_optimum() -> None:
+    qp, problem = _off_reference_qp()
+    p, a = qp.matrices(problem)
+    lower, upper = qp.bounds(problem)
+    layout = _stage_layout(qp.horizon, qp.nx, qp.nu, qp.n_constraints)
+    assert sorted(layout.columns) == list(range(qp.n_variables))  # a permutation
+    assert sorted([*layout.rows, *layout.bound_rows]) == list(range(qp.n_rows))
+    z, seconds = _solve_hpipm(p, a, lower, upper, layout)
+    assert z is not None and seconds > 0.0
+    assert np.all(a @ z >= lower - 1e-5) and np.all(a @ z <= upper + 1e-5)
+    reference = qpsolvers.solve_problem(_as_qpsolvers(p, a, lower, upper), solver="osqp",
+                                        eps_abs=1e-8, eps_rel=1e-8)  # fmt: skip
+    assert reference.x is not None
+    assert _objective(p, z) == pytest.approx(_objective(p, reference.x), rel=1e-4, abs=1e-6)
+
+
+def test_every_other_solver_reports_numbers() -> None:
+    qp, problem = _off_reference_qp()
+    out = _other_solvers(qp, [problem])
+    if casadi.has_conic("hpipm"):
+        assert "hpipm (casadi)" in out
+    for name, figures in out.items():
+        assert "error" not in figures, (name, figures)
+        assert figures["failures"] == 0, name
+        assert figures["objective_gap_max"] < 1e-3, name
 
 
 def test_bad_input_is_refused(capsys) -> None:
