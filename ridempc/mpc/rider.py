@@ -334,22 +334,20 @@ class MpcRider(Controller):
         index = self.mpc.reference.force_index
         feet = len(self.robot.params.foot_bodies)
         forces = np.zeros((feet, 3))
-        contact = np.zeros(feet, dtype=bool)
         u = plan.first_input
         site_forces = np.zeros((len(self._contact_foot), 3))
         for i, foot in enumerate(self._contact_foot):
             f = frame.vector_to_world(u[index[i]])
             site_forces[i] = f
             forces[foot] += f
-            contact[foot] |= bool(f[2] > 1e-3)
+        assert self._support is not None  # set by the MPC tick, which runs first
+        contact = np.array([c is not Contact.SWING for c in self._support])
         swing = None
-        if self._support is not None:
-            contact = np.array([c is not Contact.SWING for c in self._support])
-            if not contact.all():  # swing feet go where the plan's joint angles put them
-                q = estimate.q.copy()
-                for i, index in self._plan_joints:
-                    q[index] = x[i]
-                swing = self.wbc.model.foot_points(q)
+        if not contact.all():  # swing feet go where the plan's joint angles put them
+            q = estimate.q.copy()
+            for i, index in self._plan_joints:
+                q[index] = x[i]
+            swing = self.wbc.model.foot_points(q)
         if not contact.any():
             contact[:] = True
         targets = WbcTargets(
