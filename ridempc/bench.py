@@ -340,7 +340,12 @@ def bench_pair(robot: str, board: str, seconds: float = 2.0) -> PairBench:
             "warm_started": True,
         }
     if wbc_inputs:
-        wbc = WholeBodyController(rider.robot, pinocchio=rider.pinocchio)
+        wbc = WholeBodyController(  # the rider's own: its settings, its rolling platforms
+            rider.robot,
+            rider.wbc.settings,
+            pinocchio=rider.pinocchio,
+            platforms=rider.wbc.platforms,
+        )
         times = []
         for state, targets in wbc_inputs:
             started = time.perf_counter()

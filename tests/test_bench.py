@@ -78,3 +78,14 @@ def test_bad_input_is_refused(capsys) -> None:
     assert "cassie-skateboard" in capsys.readouterr().err
     assert main(["bench", "--seconds", "0"]) == 2
     assert "--seconds 0" in capsys.readouterr().err
+
+
+def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
+    """The recorded whole-body QPs are solved again by a WBC with the rider's own settings
+    (Cassie's springs held rigid): a default one, with passive springs, failed on 30 % of
+    the Segway's ticks and was not the controller that rode."""
+    from ridempc.bench import bench_pair
+
+    out = bench_pair("cassie", "segway", seconds=0.2)
+    assert out.ride_status == "ok" and out.wbc_ticks == 100
+    assert out.wbc_failures == 0
