@@ -17,7 +17,8 @@ Every 2 ms (500 Hz) the rider
    base pose); and solves the 500 Hz whole-body QP
    (:class:`~ridempc.wbc.WholeBodyController`). A foot the schedule puts on the ground (a
    push-off) stands on the ground for the WBC and the estimator, not on the board;
-4. sends the QP's torques as feedforward with its joint targets to the motor PD.
+4. sends the QP's torques as feedforward with its joint targets to the motor PD, at the
+   robot's ``tracking_gain_scale`` of its default gains.
 
 **Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
 fallback, counted); if the WBC fails, its last command is sent again for up to
@@ -147,8 +148,9 @@ class MpcRider(Controller):
             pinocchio=self.pinocchio,
             platforms=rolling_platforms(loaded),
         )
-        self.kp = np.array([m.kp for m in robot.motors])
-        self.kd = np.array([m.kd for m in robot.motors])
+        scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
+        self.kp = scale * np.array([m.kp for m in robot.motors])
+        self.kd = scale * np.array([m.kd for m in robot.motors])
         self._contact_foot = self._contacts_to_feet(reference.contact_names)
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.

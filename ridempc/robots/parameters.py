@@ -71,6 +71,15 @@ class RobotParameters(_Frozen):
     motors: dict[str, MotorParameters] = Field(
         min_length=1, description="Per motor, keyed by actuator name."
     )
+    tracking_gain_scale: float = Field(
+        default=1.0,
+        gt=0.0,
+        le=1.0,
+        description=(
+            "Fraction of the motors' PD gains used about the joint targets of a whole-body "
+            "controller whose torques go out as feedforward (the MPC rider) [-]."
+        ),
+    )
 
     @model_validator(mode="after")
     def _contact_sites_unique(self) -> RobotParameters:
