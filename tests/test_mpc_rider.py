@@ -137,3 +137,19 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
         mujoco.mj_kinematics(scene.model, scene_data)
         heights.append(scene_data.site_xpos[site.id][2])
     assert min(heights) < 0.03  # [m] the foot reached the ground (the deck is 0.11 m up)
+
+
+def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
+    """Cassie's motor PD follows the WBC at a tenth of its gains (``tracking_gain_scale``);
+    with the MPC she then stands on the Hovershoes (at full gains the stiff PD overrode the
+    QP's forces and she fell within 0.8 s)."""
+    cassie = load_robot("cassie")
+    assert cassie.params.tracking_gain_scale == pytest.approx(0.1)
+    rider = MpcRider(cassie, "hovershoes")
+    np.testing.assert_allclose(rider.kp, 0.1 * np.array([m.kp for m in cassie.motors]))
+    scenario = resolve_scenario("stand-still", "hovershoes").with_duration(2.0)
+    scene = build_scene(cassie, DEFAULT_PHYSICS_HZ, board=load_board("hovershoes"))
+    result = Simulation(scene, rider, scenario).run()
+    assert result.status == "ok", result.fall_reason
+    assert rider.summary()["safe_hold"] is None
+    assert np.abs(result.log["forward_velocity"]).max() < 0.3  # [m/s] (a slow drift back)
