@@ -23,6 +23,7 @@ A site is *active* when its foot is planned in contact. It then stays on its sup
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -93,6 +94,15 @@ class ContactSet:
         return cls(np.asarray(active, dtype=bool), np.tile(_AXES, (n, 1, 1)), np.zeros((n, 3)))
 
 
+@functools.lru_cache(maxsize=64)
+def _sites_on(
+    site_foot: tuple[int, ...], foot_names: tuple[str, ...], feet: tuple[str, ...]
+) -> Index:
+    """The sites of the feet named ``feet`` (a board's), layout order; few distinct calls."""
+    on = [i for i, name in enumerate(foot_names) if name in feet]
+    return np.flatnonzero(np.isin(site_foot, on))
+
+
 def build_contact_set(
     terms: ModelTerms,
     site_foot: Index,
@@ -116,8 +126,7 @@ def build_contact_set(
     active = np.asarray(contact, dtype=bool)[site_foot]
     contacts = ContactSet.on_ground(active)
     for k, board in enumerate(boards):
-        feet = [i for i, name in enumerate(foot_names) if name in board.feet]
-        sites = np.flatnonzero(np.isin(site_foot, feet))
+        sites = _sites_on(tuple(int(f) for f in site_foot), tuple(foot_names), board.feet)
         if sites.size == 0:
             continue
         contacts.frame[sites] = platform_rotation(board).T
