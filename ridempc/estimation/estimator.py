@@ -54,6 +54,13 @@ __all__ = ["StateEstimator"]
 Array = NDArray[np.float64]
 
 
+def _check_feet(what: str, names: Sequence[str], feet: Sequence[str]) -> None:
+    """Raises ConfigError: one of ``names`` is not among ``feet``."""
+    unknown = [f for f in names if f not in feet]
+    if unknown:
+        raise ConfigError(f"{what} '{unknown[0]}' is not a foot (valid: {', '.join(feet)})")
+
+
 class StateEstimator:
     """Estimates the rider's state from its sensor packets.
 
@@ -95,11 +102,7 @@ class StateEstimator:
         self.legs = LegKinematics.build(robot, self.pinocchio)
         feet = self.legs.names
         on_board = [f for group in platforms for f in group]
-        unknown = [f for f in on_board if f not in feet]
-        if unknown:
-            raise ConfigError(
-                f"platform foot '{unknown[0]}' is not a foot (valid: {', '.join(feet)})"
-            )
+        _check_feet("platform foot", on_board, feet)
         if len(set(on_board)) != len(on_board):
             raise ConfigError(f"a foot stands on two platforms: {[list(g) for g in platforms]}")
         self.platforms = tuple(tuple(group) for group in platforms if group)
@@ -130,9 +133,7 @@ class StateEstimator:
             ConfigError: A name is not a foot.
         """
         feet = self.legs.names
-        unknown = [f for f in on_ground if f not in feet]
-        if unknown:
-            raise ConfigError(f"support: '{unknown[0]}' is not a foot (valid: {', '.join(feet)})")
+        _check_feet("support:", on_ground, feet)
         self._on_ground = ~self._on_board | np.isin(feet, list(on_ground))
 
     def _sense(self, packet: SensorPacket) -> tuple[BaseAttitude, Array, Array, LegReading]:
@@ -264,17 +265,15 @@ class StateEstimator:
         v[:3] = attitude.rotation.T @ base_velocity
         feet = np.array([x[self.odometry.foot_position(i)] for i in range(len(self.legs.feet))])
         boards = []
-        on_board = stance & ~self._on_ground  # the feet that say where a board is
-        stance_sites = on_board[self.legs.site_foot]
-        names = self.legs.names
-        board_sites = (~self._on_ground)[self.legs.site_foot]
+        names, site_foot = self.legs.names, self.legs.site_foot
+        on_board = ~self._on_ground  # the feet that say where a board is: those on it,
+        in_stance = stance & on_board  # and of those, the ones in contact if any is
         for group, sites in zip(self.platforms, self._platform_sites, strict=True):
-            if np.any(sites & stance_sites):  # the feet in the air say nothing of the board
-                sites = sites & stance_sites
-                group = tuple(f for f in group if on_board[names.index(f)])
-            elif np.any(sites & board_sites):  # none in contact: all those on the board
-                sites = sites & board_sites
-                group = tuple(f for f in group if not self._on_ground[names.index(f)])
+            for reading in (in_stance, on_board):
+                if np.any(sites & reading[site_foot]):
+                    sites = sites & reading[site_foot]
+                    group = tuple(f for f in group if reading[names.index(f)])
+                    break
             boards.append(
                 estimate_board(
                     group,

@@ -82,8 +82,7 @@ def friction_pyramids(
         block = slice(ROWS_PER_CONTACT * i, ROWS_PER_CONTACT * (i + 1))
         board_rows = local @ np.asarray(surfaces[i]).T  # a^T R^T f
         rows_i = np.where(on_board[:, i, None, None], board_rows, local)  # N x 5 x 3
-        for column in range(3):
-            matrix[:, block, force_index[i][column]] = rows_i[:, :, column]
+        matrix[:, block, force_index[i]] = rows_i
         lower[:, block.start] = 0.0
         upper[:, block.start] = np.where(standing[:, i], max_force, 0.0)
     return matrix, lower, upper

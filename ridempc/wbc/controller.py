@@ -178,7 +178,7 @@ class WholeBodyController:
             if any(p is not None for p in self.platforms):
                 coupling = rng.normal(size=(n_sites, 3, n_sites, 3))
                 contacts = replace(contacts, coupling=coupling)
-            for s in range(self.model.layout.n_sites):
+            for s in range(n_sites):
                 contacts.frame[s] = pin.exp3(0.3 * rng.normal(size=3)).T
             targets = WbcTargets(
                 position=terms.com.position,
