@@ -72,3 +72,20 @@ def test_feet_can_start_off_centre(board_name: str) -> None:
         s.data.xpos[s.base_body, :2] - s.data.site_xpos[site, :2] for s in (centred, offset)
     ]
     assert np.allclose(relative[1] - relative[0], (0.03, 0.01), atol=1e-9)
+
+
+def test_a_push_off_may_put_a_foot_down_but_not_every_foot() -> None:
+    """On a board a foot on the ground is a fall; in a push-off (``feet_on_ground``) one foot
+    may stand there, but the dog standing on the floor beside its deck has stepped off."""
+    from ridempc.sim.falls import FallDetector
+
+    scene = build_scene(load_robot("cyberdog2"), DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    model, data = scene.model, scene.data
+    scene.reset()
+    mujoco.mj_forward(model, data)
+    assert FallDetector(scene, feet_on_ground=True).check(model, data) is None  # on the deck
+    data.qpos[0] += 1.0  # beside the deck
+    data.qpos[2] -= scene.support_height + 0.002  # on the floor, pressed 2 mm into it
+    mujoco.mj_forward(model, data)
+    assert "stepped off" in (FallDetector(scene, feet_on_ground=True).check(model, data) or "")
+    assert "touched the ground" in (FallDetector(scene).check(model, data) or "")

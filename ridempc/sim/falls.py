@@ -4,7 +4,8 @@ The rider fell when its base is below ``fall_height`` [m] over its starting supp
 one of its bodies that is not a foot touches the ground (for a dead weight: any of it).
 The board fell when one of its bodies other than the wheels touches the ground. On a board,
 a rider's foot on the ground is a fall too (it stepped off), unless the ride puts a foot
-there on purpose (a skateboard push-off, ``feet_on_ground``).
+there on purpose (a skateboard push-off, ``feet_on_ground``); even then, every foot on the
+ground at once is stepping off.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ class FallDetector:
         )
         on_board = scene.board is not None and not feet_on_ground
         allowed = frozenset() if on_board else scene.foot_bodies
+        # a push-off puts a foot down, never all of them
+        self._all_feet = scene.foot_bodies if scene.board is not None and feet_on_ground else None
         self._forbidden = {b: "rider" for b in scene.rider_bodies - allowed} | {
             b: "board" for b in scene.board_bodies - scene.board_ground_bodies
         }
@@ -43,6 +46,7 @@ class FallDetector:
             height = data.xpos[self._base, 2]
             if height < self._fall_height:
                 return f"base height {height:.3f} m below {self._fall_height:.3f} m"
+        grounded: set[int] = set()
         for i in range(data.ncon):
             g1, g2 = data.contact[i].geom
             for ground, other in ((g1, g2), (g2, g1)):
@@ -52,4 +56,7 @@ class FallDetector:
                         return (
                             f"{self._forbidden[body]} body '{self._names[body]}' touched the ground"
                         )
+                    grounded.add(body)
+        if self._all_feet and grounded >= self._all_feet:
+            return "rider stepped off the board: every foot on the ground"
         return None
