@@ -10,6 +10,8 @@ from ridempc.library.store import library_folder, load_library
 from ridempc.paths import motion_library_dir
 from ridempc.trajopt.pairs import EntrySpec, load_pair, pair_names
 from ridempc.trajopt.problem import collocation_defect, solve_trajectory
+from ridempc.trajopt.ride_pair import ride_models
+from ridempc.trajopt.ride_problem import ride_layout
 
 # Largest collocation defect (state units) a committed entry may have: IPOPT's constraint
 # tolerance is 1e-8 on the scaled problem.
@@ -19,6 +21,8 @@ DRIFT_TOLERANCE = 5e-3
 # Rebuilt vs committed: states [SI] and inputs relative to their largest magnitude.
 REBUILD_STATE_TOLERANCE = 1e-4
 REBUILD_INPUT_TOLERANCE = 1e-3
+# Largest excursion of a Cassie entry's centre of mass from its riding height [m].
+HEIGHT_TOLERANCE = 0.03
 
 PAIRS = [name for name in pair_names() if (motion_library_dir() / name / "manifest.json").exists()]
 
@@ -74,3 +78,17 @@ def test_rebuilding_the_smallest_entry_reproduces_it() -> None:
     assert np.allclose(solution.states, smallest.states, atol=REBUILD_STATE_TOLERANCE, rtol=0)
     scale = np.max(np.abs(smallest.inputs), axis=0) + 1e-9
     assert np.max(np.abs(solution.inputs - smallest.inputs) / scale) < REBUILD_INPUT_TOLERANCE
+
+
+@pytest.mark.parametrize("pair_name", [name for name in PAIRS if name.startswith("cassie-")])
+def test_the_rider_keeps_its_riding_height(pair_name: str) -> None:
+    """Every Cassie entry keeps the centre of mass within ``HEIGHT_TOLERANCE`` of the riding
+    keyframe's height: a crouch the task does not ask for puts the shins on the Segway's
+    knee pad, which then steers (the 3 and 4 m/s entries once sank 0.13 m)."""
+    robot, board = _split(pair_name)
+    rider, wheeled = ride_models(robot, board)
+    height = ride_layout(rider, wheeled)["com_height"]
+    _, entries = load_library(library_folder(robot, board))
+    for entry in entries:
+        sag = float(np.max(np.abs(entry.state("com_z") - height)))
+        assert sag < HEIGHT_TOLERANCE, f"{entry.record.name}: {sag:.3f} m off {height:.3f} m"
