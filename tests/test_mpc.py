@@ -26,7 +26,7 @@ from ridempc.mpc import (
     select_reference,
 )
 from ridempc.mpc.friction import ROWS_PER_CONTACT
-from ridempc.mpc.manoeuvre import RETARGET_BAND, ManoeuvreSelector, StateLayout
+from ridempc.mpc.manoeuvre import RETARGET_BAND, Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
@@ -413,6 +413,29 @@ def test_a_ramped_command_retargets_in_steps_not_at_every_tick() -> None:
     stepped = selector.select(Command(velocity=2.0), current, 2.0, 1.0)
     assert stepped.target == pytest.approx(2.0)
     assert selector.select(Command(velocity=2.1), stepped, 2.1, 1.0) is stepped
+
+
+def test_a_slower_speed_is_ridden_at_not_started_from_rest() -> None:
+    """Slowing from 4 to 3.75 m/s picks the 3.75 m/s entry where it rides steadily, not
+    its start at rest; speeding up still starts where the reference passes the speed."""
+    times = np.linspace(0.0, 8.0, 81)
+    speeds = np.clip((times - 0.5) / 7.0, 0.0, 1.0) * 3.75  # rest -> 3.75 m/s
+    slower = ManoeuvreSelector.phase_start(times, speeds, 3.97, 10.0, "accelerate")
+    assert 10.0 - slower == pytest.approx(times[-1])
+    faster = ManoeuvreSelector.phase_start(times, speeds, 1.5, 10.0, "accelerate")
+    match = int(np.argmin(np.abs(times - (10.0 - faster))))
+    assert speeds[match - 1] < 1.5 <= speeds[match]  # the first node at that speed
+
+
+def test_slowing_down_brakes_along_a_stop_then_rides_at_the_command() -> None:
+    selector = ManoeuvreSelector("cassie", "segway")
+    riding = Manoeuvre("accelerate", 4.0, 0.0)
+    command = Command(velocity=3.7)
+    braking = selector.select(command, riding, 20.0, 4.0)
+    assert braking.kind == "stop" and braking.target == pytest.approx(4.0)
+    assert selector.select(command, braking, 21.0, 3.96) is braking  # still braking
+    settled = selector.select(command, braking, 22.0, 3.7)
+    assert settled.kind == "accelerate" and settled.target == pytest.approx(3.7)
 
 
 def test_a_commanded_roll_moves_the_reference_to_a_balance(skate_mpc: LinearMpc) -> None:

@@ -153,3 +153,28 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     assert result.status == "ok", result.fall_reason
     assert rider.summary()["safe_hold"] is None
     assert np.abs(result.log["forward_velocity"]).max() < 0.3  # [m/s] (a slow drift back)
+
+
+def test_the_frame_follows_the_board_sideways_only(dog) -> None:
+    """``follow_sideways`` puts the board on the reference's line (here 0.2 m to its side,
+    at 0.3 rad) and keeps its place along the line and the rider's offset from it."""
+    _, rider = _ride(dog, 0.1)
+    estimate = rider.estimator.state
+    assert estimate is not None
+    n, state_map = rider.layout.names, rider.map
+    before = state_map.state(estimate)
+    x, y = before[n["board_x"]], before[n["board_y"]]
+    yaw = 0.3
+    normal = np.array([-np.sin(yaw), np.cos(yaw)])
+    line = np.array([x, y]) + 0.2 * normal  # a line through here, shifted 0.2 m across
+    shift = state_map.follow_sideways(estimate, (line[0], line[1], yaw))
+    assert shift == pytest.approx(-0.2)
+    after = state_map.state(estimate)
+    board = np.array([after[n["board_x"]], after[n["board_y"]]])
+    assert normal @ (board - line) == pytest.approx(0.0, abs=1e-12)  # on the line
+    along = np.array([np.cos(yaw), np.sin(yaw)])
+    assert along @ (board - np.array([x, y])) == pytest.approx(0.0, abs=1e-12)
+    for axis in ("x", "y"):  # the rider moves with the board
+        gap_before = before[n[f"com_{axis}"]] - before[n[f"board_{axis}"]]
+        assert after[n[f"com_{axis}"]] - after[n[f"board_{axis}"]] == pytest.approx(gap_before)
+    assert after[n["board_yaw"]] == pytest.approx(before[n["board_yaw"]])

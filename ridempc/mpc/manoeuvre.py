@@ -11,9 +11,15 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily;
   while the command is ramping, it is kept as long as the command stays within
   ``RETARGET_BAND`` of its target (a ramp retargets in a few steps, not at every tick), and
-  it moves to the exact command once the command settles;
+  it moves to the exact command once the command settles; a lower speed that is not rest
+  starts at the entry's end, riding steadily at it;
 - **stop** when the command returns to zero, where the library has ``stop`` entries (the
-  skateboard has none: it coasts on, four-leg balancing).
+  skateboard has none: it coasts on, four-leg balancing); also to **slow down** while the
+  board is more than ``RETARGET_BAND`` faster than a commanded speed that is not rest: the
+  stop from the board's speed, started at its phase, brakes as the library found feasible,
+  and once the board is down to the command the ``accelerate`` entry of that speed rides
+  on at it (started at its end). A speed reference stepped down instead (0.25 m/s at a
+  time, as a ramp retargets) braked the Segway from 4 m/s into a fall.
 
 Targets beyond the library's range are clamped to it. On top of the trajectory the command
 sets the deck roll (the skateboard's ``board_roll`` and ``board_roll_rate``) over the
@@ -162,6 +168,10 @@ class ManoeuvreSelector:
                 return current
             return Manoeuvre("stop", self._clamped("stop", max(speed, current.target)), now)
         previous, self._last_wanted = self._last_wanted, wanted
+        if "stop" in self.targets and speed > wanted + RETARGET_BAND:
+            if current.kind == "stop":
+                return current
+            return Manoeuvre("stop", self._clamped("stop", speed), now)
         goal = Manoeuvre("accelerate", self._clamped("accelerate", wanted), now)
         if current.kind == "accelerate":
             gap = abs(goal.target - current.target)
@@ -173,12 +183,23 @@ class ManoeuvreSelector:
     @staticmethod
     def phase_start(times: Array, speeds: Array, speed: float, now: float, kind: str) -> float:
         """The start time that puts ``now`` at the reference's first time where its speed
-        reaches ``speed`` (rising for ``accelerate``, falling for ``stop``)."""
+        reaches ``speed`` (rising for ``accelerate``, falling for ``stop``).
+
+        A board already faster than the whole ``accelerate`` reference (a slow-down to a
+        lower speed that is not rest) starts at the reference's end, riding steadily at
+        its target: the MPC brakes to it. Started from rest instead, the reference asked a
+        rider at 4 m/s for 0 m/s at once (the Segway's stop from 4 m/s fell in 0.3 s).
+        """
         if kind == "accelerate":
             reached = np.nonzero(speeds >= speed)[0]
+            beyond = speed > float(speeds[-1])
         else:
             reached = np.nonzero(speeds <= speed)[0]
-        t_match = float(times[reached[0]]) if reached.size else 0.0
+            beyond = False
+        if beyond:
+            t_match = float(times[-1])
+        else:
+            t_match = float(times[reached[0]]) if reached.size else 0.0
         return now - t_match
 
     @staticmethod

@@ -5,7 +5,9 @@ Every 2 ms (500 Hz) the rider
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
    board from its own feet);
 2. every 15th tick (30 Hz), maps the estimate into the library frame
-   (:class:`~ridempc.mpc.state_map.StateMap`) and solves the linear MPC
+   (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto the
+   reference's line: speeds and turn rates are commanded, not a path) and solves the
+   linear MPC
    (:class:`~ridempc.mpc.controller.LinearMpc`) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
@@ -15,7 +17,8 @@ Every 2 ms (500 Hz) the rider
    contact as the schedule has them over the step, and, for a foot the schedule lifts, a
    swing target where the plan's joint angles put it (forward kinematics at the estimated
    base pose); and solves the 500 Hz whole-body QP
-   (:class:`~ridempc.wbc.WholeBodyController`). A foot the schedule puts on the ground (a
+   (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the stance the
+   rider starts from on the board). A foot the schedule puts on the ground (a
    push-off) stands on the ground for the WBC and the estimator, not on the board;
 4. sends the QP's torques as feedforward with its joint targets to the motor PD, at the
    robot's ``tracking_gain_scale`` of its default gains.
@@ -57,6 +60,7 @@ from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.trajopt.schedule import Contact
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
+from ridempc.wbc.controller import motor_posture
 from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.settings import WbcSettings
@@ -146,6 +150,7 @@ class MpcRider(Controller):
             robot,
             settings_wbc,
             pinocchio=self.pinocchio,
+            posture=motor_posture(self.pinocchio, robot, robot.stance_qpos(board)),
             platforms=rolling_platforms(loaded),
         )
         scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
@@ -259,8 +264,10 @@ class MpcRider(Controller):
             )
             self.manoeuvre = replace(wanted, start=start)
             self._anchor(estimate, now)
-        x0 = self.map.state(estimate)
         t_ref = self.manoeuvre.reference_time(now)
+        line = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
+        self.map.follow_sideways(estimate, self.layout.board_pose(line))
+        x0 = self.map.state(estimate)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
         names, roll = self.layout.names, self._roll_horizon(command, now, problem)

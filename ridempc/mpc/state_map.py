@@ -23,6 +23,8 @@ keeps a planar transform :math:`(\\Delta\\psi, \\Delta p)` from the world to tha
 :math:`p_{lib} = R_z(-\\Delta\\psi)(p - \\Delta p)`, set by :meth:`StateMap.anchor` so that
 the estimated board pose lands on the reference's board pose at the moment a manoeuvre
 starts; positions, velocities, headings and forces are carried through it both ways.
+Between anchors :meth:`StateMap.follow_sideways` keeps the board on the reference's line
+(the rider tracks commanded speeds and turn rates, not a path).
 """
 
 from __future__ import annotations
@@ -230,3 +232,33 @@ class StateMap:
             float(position[1] - (s * x_ref + c * y_ref)),
         )
         self.frame = PlanarFrame(dyaw, offset)
+
+    def follow_sideways(
+        self, estimate: EstimatedState, board_pose: tuple[float, float, float]
+    ) -> float:
+        """Shift the frame across the reference's heading so that platform 0's estimate
+        lies on the reference's line: its cross-track offset
+
+        .. math:: e = n^\\top (p_{lib} - p_{ref}), \\qquad n = (-\\sin\\psi_{ref},
+            \\cos\\psi_{ref})
+
+        [m] becomes zero; heading and the offset along the line are kept. A rider is
+        commanded speeds and turn rates, not a line on the ground, and a board on wheels
+        cannot move sideways but by turning: at 4 m/s a heading error of 5 mrad carries
+        the Segway 0.1 m off the reference's line in 5 s, and the MPC, holding the
+        rider's centre of mass on that line, leaned Cassie off her platform (velocity
+        steps fell at 26.4 s). Offsets between the rider and the board are unchanged.
+
+        Returns:
+            The shift :math:`e` [m] (0 without a board estimate).
+        """
+        if not estimate.boards:
+            return 0.0
+        x_ref, y_ref, yaw_ref = board_pose
+        p_lib = self.frame.point_to_library(estimate.boards[0].position)
+        normal = np.array([-math.sin(yaw_ref), math.cos(yaw_ref), 0.0])
+        error = float(normal[:2] @ (p_lib[:2] - np.array([x_ref, y_ref])))
+        shift = self.frame.vector_to_world(error * normal)
+        offset = (self.frame.offset[0] + float(shift[0]), self.frame.offset[1] + float(shift[1]))
+        self.frame = PlanarFrame(self.frame.yaw, offset)
+        return error

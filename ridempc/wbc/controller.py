@@ -62,7 +62,7 @@ from ridempc.wbc.tasks import (
     TranslationTask,
 )
 
-__all__ = ["TRACKED_POINTS", "WholeBodyController", "to_motor_command"]
+__all__ = ["TRACKED_POINTS", "WholeBodyController", "motor_posture", "to_motor_command"]
 
 Array = NDArray[np.float64]
 
@@ -71,6 +71,14 @@ TRACKED_POINTS: dict[str, type[TranslationTask]] = {
     "base": BasePositionTask,
 }
 GRAVITY: float = 9.81  # [m] / [s]^2
+
+
+def motor_posture(pinocchio: PinocchioRobot, robot: Robot, qpos: Array) -> Array:
+    """The motor joint angles [rad] of a MuJoCo configuration ``qpos``, actuator order (a
+    posture for :class:`WholeBodyController`)."""
+    model = pinocchio.model
+    q = pinocchio.coordinates.qpos_to_pinocchio(qpos)
+    return np.array([q[model.joints[model.getJointId(m.joint)].idx_q] for m in robot.motors])
 
 
 class WholeBodyController:
@@ -110,8 +118,9 @@ class WholeBodyController:
             [model.joints[model.getJointId(m.joint)].idx_q for m in robot.motors], dtype=np.int64
         )
         self.motor_v = self.model.motor_v
-        stand = self.model.pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
-        self.posture = np.asarray(stand[self.motor_q] if posture is None else posture, dtype=float)
+        if posture is None:
+            posture = motor_posture(self.model.pinocchio, robot, robot.stand_qpos)
+        self.posture = np.asarray(posture, dtype=float)
         if self.posture.shape != (len(robot.motors),):
             raise ConfigError(
                 f"WBC: posture has {self.posture.size} angles, robot '{robot.name}' has "
@@ -120,6 +129,7 @@ class WholeBodyController:
         self.qp = WholeBodyQP(
             self.model.layout, self._tasks(), self._constraints(), self.settings.osqp
         )
+        stand = self.model.pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
         for problem in self._probe_problems(stand):
             self.qp.include_pattern(problem)
         site_foot = self.model.site_foot
