@@ -32,10 +32,11 @@ import pytest
 from ridempc.boards import load_board
 from ridempc.controllers import StandController, make_controller
 from ridempc.errors import ConfigError
-from ridempc.estimation import EstimatorParameters, StateEstimator, estimate_board
+from ridempc.estimation import EstimatorParameters, StateEstimator, estimate_board, lapack
 from ridempc.estimation.imu import GRAVITY, ImuMount
 from ridempc.estimation.leg_odometry import LegOdometryModel
 from ridempc.estimation.rotations import matrix_to_quaternion, quaternion_to_matrix
+from ridempc.estimation.state import JointValues
 from ridempc.robots import load_robot
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -388,3 +389,43 @@ def test_first_estimate_on_a_board_stands_on_its_deck(robot_name: str, board: st
     first = int(np.flatnonzero(np.isfinite(log["estimate_base_position"][:, 2]))[0])
     error = log["estimate_base_position"][first, 2] - log["base_position"][first, 2]
     assert abs(error) < 0.03, error
+
+
+def test_leg_measurements_are_stacked_foot_by_foot() -> None:
+    """Per foot its offset, then the negated velocity of a stance foot, in H's row order."""
+    model = LegOdometryModel(3, EstimatorParameters())
+    rng = np.random.default_rng(4)
+    offsets, velocities = rng.normal(size=(3, 3)), rng.normal(size=(3, 3))
+    stance = np.array([True, False, True])
+    measurement = model.legs(offsets, velocities, stance)
+    expected = [offsets[0], -velocities[0], offsets[1], offsets[2], -velocities[2]]
+    np.testing.assert_array_equal(measurement.z, np.concatenate(expected))
+    x = rng.normal(size=model.size)  # H picks p_i - p_S and p_S' - u_i in the same order
+    predicted = [x[6:9] - x[:3], x[3:6] - x[9:12], x[12:15] - x[:3]]
+    predicted += [x[18:21] - x[:3], x[3:6] - x[21:24]]
+    np.testing.assert_allclose(measurement.H @ x, np.concatenate(predicted), atol=1e-15)
+
+
+def test_lapack_helpers_give_numpys_results() -> None:
+    rng = np.random.default_rng(5)
+    a = rng.normal(size=(9, 9))
+    a = a @ a.T + np.eye(9)
+    b = rng.normal(size=(9, 4))
+    x = lapack.solve(a, b)
+    assert x.flags.c_contiguous
+    np.testing.assert_allclose(x, np.linalg.solve(a, b), rtol=1e-13, atol=0.0)
+    np.testing.assert_allclose(lapack.solve(a, b[:, 0]), np.linalg.solve(a, b[:, 0]), rtol=1e-13)
+    points = rng.normal(size=(4, 3))
+    for ours, numpys in zip(lapack.svd(points), np.linalg.svd(points), strict=True):
+        np.testing.assert_allclose(ours, numpys, rtol=1e-13, atol=1e-15)
+    with pytest.raises(np.linalg.LinAlgError):
+        lapack.solve(np.zeros((3, 3)), np.ones(3))
+
+
+def test_joint_values_read_their_array_by_name() -> None:
+    values = JointValues({"hip": 0, "knee": 1}, np.array([0.1, -0.2]))
+    assert list(values) == ["hip", "knee"] and len(values) == 2
+    assert values["knee"] == -0.2 and isinstance(values["knee"], float)
+    assert dict(values) == {"hip": 0.1, "knee": -0.2}
+    with pytest.raises(KeyError):
+        values["ankle"]

@@ -20,9 +20,13 @@ stance feet's contact points :math:`c_k` (world, [m]) and velocities:
 
 from __future__ import annotations
 
+import math
+
+import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.estimation.lapack import svd
 from ridempc.estimation.rotations import rpy_of_matrix
 from ridempc.estimation.state import BoardEstimate
 
@@ -30,23 +34,26 @@ __all__ = ["estimate_board"]
 
 Array = NDArray[np.float64]
 COLLINEAR: float = 1e-3  # [m] RMS distance from the best line below which points are a line
+UP: Array = np.array([0.0, 0.0, 1.0])
+UP.flags.writeable = False
 
 
-def _normal(points: Array, up_hint: Array) -> Array:
-    centred = points - points.mean(axis=0)
-    if len(points) >= 2:
-        _, singular, vt = np.linalg.svd(centred, full_matrices=True)
+def _normal(centred: Array, up_hint: Array) -> Array:
+    """The plane's upward unit normal, from the points less their centroid [m]."""
+    count = len(centred)
+    if count >= 2:
+        _, singular, vt = svd(centred)
     else:
         singular, vt = np.zeros(1), np.eye(3)
     second = singular[1] if singular.size > 1 else 0.0
-    if len(points) >= 3 and second / np.sqrt(len(points)) > COLLINEAR:
+    if count >= 3 and second / math.sqrt(count) > COLLINEAR:
         normal = vt[2]
-    elif len(points) >= 2 and singular[0] > 0.0:
+    elif count >= 2 and singular[0] > 0.0:
         line = vt[0]
         normal = up_hint - line * (line @ up_hint)
     else:
         normal = up_hint.copy()
-    normal /= np.linalg.norm(normal)
+    normal /= math.sqrt(normal @ normal)  # np.linalg.norm's sum, without its wrapper
     return normal if normal[2] >= 0.0 else -normal
 
 
@@ -73,22 +80,25 @@ def estimate_board(
     if points.shape[0] == 0:
         raise ValueError("a board estimate needs at least one foot contact point")
     velocities = np.asarray(velocities, dtype=float).reshape(-1, 3)
-    hint = np.array([0.0, 0.0, 1.0]) if up_hint is None else np.asarray(up_hint, dtype=float)
-    z_axis = _normal(points, hint)
+    hint = UP if up_hint is None else np.asarray(up_hint, dtype=float)
+    count = len(points)
+    centre = points.sum(axis=0) / count  # np.mean's own sum and division, not its wrapper
+    centred = points - centre
+    z_axis = _normal(centred, hint)
     x_axis = forward - z_axis * (z_axis @ forward)
-    norm = np.linalg.norm(x_axis)
+    norm = math.sqrt(x_axis @ x_axis)
     if norm < 1e-6:
         raise ValueError("the rider's forward direction is normal to the board")
     x_axis /= norm
-    rotation = np.column_stack([x_axis, np.cross(z_axis, x_axis), z_axis])
-    roll, pitch, yaw = rpy_of_matrix(rotation)
-    centre = points.mean(axis=0)
-    mean_velocity = velocities.mean(axis=0)
-    r = (points - centre)[:, :2]
+    y_axis = np.empty(3)
+    mujoco.mju_cross(y_axis, z_axis, x_axis)  # np.cross costs 30 us on 3-vectors, this 1
+    roll, pitch, yaw = rpy_of_matrix(np.array((x_axis, y_axis, z_axis)).T)
+    mean_velocity = velocities.sum(axis=0) / count
+    r = centred[:, :2]
     r_dot = (velocities - mean_velocity)[:, :2]
-    spread = float(np.sum(r**2))
+    spread = float((r**2).sum())
     yaw_rate = (
-        float(np.sum(r[:, 0] * r_dot[:, 1] - r[:, 1] * r_dot[:, 0]) / spread)
+        float((r[:, 0] * r_dot[:, 1] - r[:, 1] * r_dot[:, 0]).sum() / spread)
         if spread > 1e-6
         else 0.0
     )

@@ -21,12 +21,14 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError, UnknownNameError
+from ridempc.estimation.lapack import solve
 from ridempc.estimation.legs import LegKinematics, LegReading
 from ridempc.estimation.parameters import EstimatorParameters
 from ridempc.robots.pinocchio_model import PinocchioRobot
@@ -156,9 +158,14 @@ class TorqueLoad(FootLoad):
         # J^T f = g - tau for all feet at once; least squares f = (J J^T)^-1 J (g - tau)
         jacobian = legs.foot_jacobian[:, :, self.joints].reshape(-1, self.joints.size)
         jacobian = jacobian * self.on_chain
-        gram = jacobian @ jacobian.T + 1e-9 * np.eye(jacobian.shape[0])
-        force = np.linalg.solve(gram, jacobian @ residual).reshape(-1, 3)
+        gram = jacobian @ jacobian.T + self._ridge
+        force = solve(gram, jacobian @ residual).reshape(-1, 3)
         return force[:, 2] / self.share
+
+    @cached_property
+    def _ridge(self) -> Array:
+        """:math:`10^{-9} I` [m^2], keeping the Gram matrix of a singular leg invertible."""
+        return 1e-9 * np.eye(self.on_chain.shape[0])
 
 
 CONTACT_LOADS: dict[str, Callable[[Robot, PinocchioRobot, LegKinematics], FootLoad]] = {

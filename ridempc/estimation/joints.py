@@ -103,8 +103,9 @@ class JointMap:
             encoder_position: Encoder angles [rad], packet order.
             encoder_velocity: Encoder rates [rad/s], packet order.
         """
-        w, x, y, z = base_quaternion
-        q[:7] = (0.0, 0.0, 0.0, x, y, z, w)
+        q[:3] = 0.0
+        q[3:6] = base_quaternion[1:]  # Pinocchio's (x, y, z, w)
+        q[6] = base_quaternion[0]
         q[self.encoder_q] = encoder_position
         v[:3] = 0.0
         v[3:6] = base_angular_velocity

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.estimation.lapack import solve
+
 __all__ = ["LinearKalmanFilter"]
 
 Array = NDArray[np.float64]
@@ -80,7 +82,7 @@ class LinearKalmanFilter:
                 keep = np.ones(y.size, dtype=bool)
                 keep[gated[outliers].ravel()] = False
                 y, PHt, S = y[keep], PHt[:, keep], S[np.ix_(keep, keep)]
-        K = np.linalg.solve(S, PHt.T).T
+        K = solve(S, PHt.T).T
         correction = K @ y
         self.x = self.x + correction
         P = self.P - K @ PHt.T

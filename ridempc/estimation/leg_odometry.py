@@ -51,6 +51,7 @@ from ridempc.estimation.parameters import EstimatorParameters
 __all__ = ["LegOdometryModel", "Measurement"]
 
 Array = NDArray[np.float64]
+Index = NDArray[np.int64]
 I3 = np.eye(3)
 
 
@@ -95,6 +96,10 @@ class LegOdometryModel:
     @staticmethod
     def support_velocity(i: int) -> slice:
         return slice(9 + 6 * i, 12 + 6 * i)
+
+    def foot_positions(self, x: Array) -> Array:
+        """Every foot's :math:`p_i` in a state ``x`` [m], shape (feet, 3)."""
+        return x[6:].reshape(self.feet, 6)[:, :3].copy()
 
     def initial_state(
         self, imu_position: Array, imu_velocity: Array, foot_offsets: Array, height_known: bool
@@ -188,25 +193,26 @@ class LegOdometryModel:
             foot_velocities: :math:`w_i - w_S` [m/s], shape (feet, 3).
             stance: Feet in contact.
         """
-        H, R, gated = self._leg_matrices(stance.tobytes())
-        values: list[Array] = []
-        for i in range(self.feet):
-            values.append(foot_offsets[i])
-            if stance[i]:
-                values.append(-foot_velocities[i])
-        return Measurement(H=H, z=np.concatenate(values), R=R, gated=gated)
+        H, R, gated, position_rows = self._leg_matrices(stance.tobytes())
+        z = np.empty((H.shape[0] // 3, 3))  # one row a 3-vector, in H's order
+        z[position_rows] = foot_offsets
+        z[gated[:, 0] // 3] = -foot_velocities[stance]
+        return Measurement(H=H, z=z.ravel(), R=R, gated=gated)
 
     @functools.lru_cache(maxsize=64)  # noqa: B019 - at most 2^feet patterns
-    def _leg_matrices(self, stance_key: bytes) -> tuple[Array, Array, NDArray[np.int64]]:
-        """:math:`(H, R)` of the leg measurements in :meth:`legs`'s row order, and the row
-        groups of the stance-foot velocities (tested for outliers)."""
+    def _leg_matrices(self, stance_key: bytes) -> tuple[Array, Array, Index, Index]:
+        """:math:`(H, R)` of the leg measurements in :meth:`legs`'s row order (per foot its
+        position, then its velocity if in stance), the row groups of the stance-foot
+        velocities (tested for outliers) and the 3-row blocks of the foot positions."""
         stance = np.frombuffer(stance_key, dtype=bool)
         p = self.params
         blocks: list[list[tuple[slice, Array]]] = []
         stds: list[float] = []
         gated: list[range] = []
+        positions: list[int] = []
         for i in range(self.feet):
             f, u = self.foot_position(i), self.support_velocity(i)
+            positions.append(len(blocks))
             blocks.append([(f, I3), (slice(0, 3), -I3)])
             stds.append(p.kinematic_position_std)
             if stance[i]:
@@ -218,16 +224,23 @@ class LegOdometryModel:
             for where, block in pieces:
                 H[3 * row : 3 * row + 3, where] = block
         R = np.diag(np.repeat(np.square(stds), 3))
-        H.flags.writeable = False
-        R.flags.writeable = False
         rows = np.array(gated, dtype=np.int64).reshape(-1, 3)
-        rows.flags.writeable = False
-        return H, R, rows
+        position_rows = np.array(positions, dtype=np.int64)
+        for array in (H, R, rows, position_rows):
+            array.flags.writeable = False
+        return H, R, rows, position_rows
 
     def vio(self, imu_position: Array, imu_velocity: Array) -> Measurement:
         """The VIO measurement of :math:`p_S` [m] and :math:`\\dot p_S` [m/s]."""
+        H, R = self._vio_matrices
+        return Measurement(H=H, z=np.concatenate([imu_position, imu_velocity]), R=R)
+
+    @functools.cached_property
+    def _vio_matrices(self) -> tuple[Array, Array]:
         p = self.params
         H = np.zeros((6, self.size))
         H[:, :6] = np.eye(6)
         R = np.diag(np.repeat([p.vio_position_std**2, p.vio_velocity_std**2], 3))
-        return Measurement(H=H, z=np.concatenate([imu_position, imu_velocity]), R=R)
+        H.flags.writeable = False
+        R.flags.writeable = False
+        return H, R

@@ -117,7 +117,7 @@ class LegKinematics:
         site_foot = np.array([i for i, f in enumerate(feet) for _ in f.sites], dtype=np.int64)
         return cls(tuple(feet), site_foot, pinocchio.frame_id(robot.params.imu_site))
 
-    @property
+    @cached_property
     def names(self) -> tuple[str, ...]:
         return tuple(f.name for f in self.feet)
 
@@ -127,15 +127,16 @@ class LegKinematics:
         Args:
             model: The Pinocchio model.
             data: Its data after ``computeJointJacobians`` at the current :math:`q`
-                (base at the origin); frame placements are updated here.
+                (base at the origin); the placements of the frames read are updated here.
             v: The current velocity (base linear velocity zero).
         """
-        pin.updateFramePlacements(model, data)
         frames = self._frames
         points = np.empty((len(frames), 3))
         jacobians = np.empty((len(frames), 3, model.nv))
         for k, frame in enumerate(frames):
-            points[k] = data.oMf[frame].translation
+            # the frames read, not all of them (updateFramePlacements): reading data.oMf
+            # costs more than placing a frame
+            points[k] = pin.updateFramePlacement(model, data, frame).translation
             jacobians[k] = pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3]
         velocities = jacobians @ v
         sites = slice(0, len(frames) - 1)

@@ -36,6 +36,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.estimation.lapack import solve
 
 __all__ = ["LoopClosure"]
 
@@ -135,17 +136,19 @@ class LoopClosure:
         jacobian = self.jacobian(model, data)
         # J_u^T (J_u J_u^T + lambda I)^-1: the Gauss-Newton step and the velocity map
         pseudo_inverse = self._pseudo_inverse(jacobian[:, u])
+        error = float(np.abs(r).max())
         for _ in range(self.max_iterations):
-            if float(np.abs(r).max()) < self.tolerance:
+            if error < self.tolerance:
                 break
             step[u] = -pseudo_inverse @ r
             q = pin.integrate(model, q, step)
             pin.computeJointJacobians(model, data, q)
             r = self.residual(model, data)
-            if float(np.abs(r).max()) >= self.tolerance:  # not converged: relinearise
+            error = float(np.abs(r).max())
+            if error >= self.tolerance:  # not converged: relinearise
                 jacobian = self.jacobian(model, data)
                 pseudo_inverse = self._pseudo_inverse(jacobian[:, u])
-        self.last_residual = float(np.abs(r).max())
+        self.last_residual = error
         # velocities from the last linearisation: at q, or one converged step before it
         v = v.copy()
         v[u] = -pseudo_inverse @ (jacobian[:, self.measured_v] @ v[self.measured_v])
@@ -154,4 +157,4 @@ class LoopClosure:
     def _pseudo_inverse(self, jacobian_u: Array) -> Array:
         gram = jacobian_u @ jacobian_u.T
         gram.flat[:: gram.shape[0] + 1] += self.damping
-        return np.asarray(np.linalg.solve(gram, jacobian_u).T, dtype=np.float64)
+        return solve(gram, jacobian_u).T

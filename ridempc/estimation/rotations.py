@@ -63,6 +63,6 @@ def yaw_of(quat_wxyz: Array) -> float:
 def rpy_of_matrix(rotation: Array) -> tuple[float, float, float]:
     """Roll, pitch, yaw [rad] of :math:`R = R_z(\\psi) R_y(\\theta) R_x(\\phi)`."""
     roll = float(np.arctan2(rotation[2, 1], rotation[2, 2]))
-    pitch = float(-np.arcsin(np.clip(rotation[2, 0], -1.0, 1.0)))
+    pitch = float(-np.arcsin(min(max(rotation[2, 0], -1.0), 1.0)))  # np.clip: 5 us a scalar
     yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
     return roll, pitch, yaw

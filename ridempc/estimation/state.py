@@ -6,7 +6,7 @@ Frames: ``W`` is the world (z up), ``B`` the robot's base body. Quaternions are
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,9 +14,39 @@ from numpy.typing import NDArray
 
 from ridempc.estimation.rotations import quaternion_to_matrix, yaw_of
 
-__all__ = ["BoardEstimate", "EstimatedState"]
+__all__ = ["BoardEstimate", "EstimatedState", "JointValues"]
 
 Array = NDArray[np.float64]
+
+
+class JointValues(Mapping[str, float]):
+    """Joint values by name, read from an array when asked.
+
+    The estimator reports every joint by name at 500 Hz, and its readers look a few up at
+    the MPC's 30 Hz: a dict of them each tick cost more than the lookups.
+
+    Args:
+        index: Position in ``values`` of each joint, in the map's order.
+        values: The values [rad or rad/s]; kept, not copied.
+    """
+
+    __slots__ = ("_index", "_values")
+
+    def __init__(self, index: Mapping[str, int], values: Array) -> None:
+        self._index = index
+        self._values = values
+
+    def __getitem__(self, name: str) -> float:
+        return float(self._values[self._index[name]])
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._index)
+
+    def __len__(self) -> int:
+        return len(self._index)
+
+    def __repr__(self) -> str:
+        return f"JointValues({dict(self)!r})"
 
 
 @dataclass(frozen=True)
