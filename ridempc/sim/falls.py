@@ -11,6 +11,7 @@ ground at once is stepping off.
 from __future__ import annotations
 
 import mujoco
+import numpy as np
 
 from ridempc.sim.scene import Scene
 
@@ -35,10 +36,14 @@ class FallDetector:
         self._forbidden = {b: "rider" for b in scene.rider_bodies - allowed} | {
             b: "board" for b in scene.board_bodies - scene.board_ground_bodies
         }
-        self._ground = scene.ground_geoms
         self._names = {
             b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in self._forbidden
         }
+        # lookup tables, to judge all the contacts at once rather than one at a time
+        self._is_ground = np.zeros(model.ngeom, dtype=bool)
+        self._is_ground[list(scene.ground_geoms)] = True
+        self._is_forbidden = np.zeros(model.nbody, dtype=bool)
+        self._is_forbidden[list(self._forbidden)] = True
 
     def check(self, model: mujoco.MjModel, data: mujoco.MjData) -> str | None:
         """The reason of a fall now, or None."""
@@ -46,17 +51,15 @@ class FallDetector:
             height = data.xpos[self._base, 2]
             if height < self._fall_height:
                 return f"base height {height:.3f} m below {self._fall_height:.3f} m"
-        grounded: set[int] = set()
-        for i in range(data.ncon):
-            g1, g2 = data.contact[i].geom
-            for ground, other in ((g1, g2), (g2, g1)):
-                if ground in self._ground:
-                    body = int(model.geom_bodyid[other])
-                    if body in self._forbidden:
-                        return (
-                            f"{self._forbidden[body]} body '{self._names[body]}' touched the ground"
-                        )
-                    grounded.add(body)
-        if self._all_feet and grounded >= self._all_feet:
+        geoms = data.contact.geom[: data.ncon]
+        # per contact, the body of each geom touching the ground: (g1 on ground -> g2's, then
+        # g2 on ground -> g1's), contact by contact
+        others = geoms[:, ::-1][self._is_ground[geoms]]
+        bodies = model.geom_bodyid[others]
+        forbidden = self._is_forbidden[bodies]
+        if forbidden.any():
+            body = int(bodies[forbidden.argmax()])
+            return f"{self._forbidden[body]} body '{self._names[body]}' touched the ground"
+        if self._all_feet and set(bodies.tolist()) >= self._all_feet:
             return "rider stepped off the board: every foot on the ground"
         return None

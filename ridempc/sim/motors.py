@@ -57,8 +57,9 @@ class MotorCommand:
         )
 
     def is_finite(self) -> bool:
+        # the arrays' own all(): np.all's wrapper costs 3 us, five times a tick
         return all(
-            np.all(np.isfinite(a))
+            np.isfinite(a).all()
             for a in (self.torque, self.position, self.velocity, self.kp, self.kd)
         )
 
@@ -81,6 +82,7 @@ class MotorDriver:
         self._actuators = actuator_ids
         self._gear = np.array([m.gear for m in motors])
         self._limit = np.array([m.torque_limit for m in motors])
+        self._negative_limit = -self._limit
         self._speed = np.array([m.speed_limit for m in motors])
         self.command: MotorCommand | None = None
 
@@ -92,9 +94,11 @@ class MotorDriver:
         q = data.qpos[self._qpos]
         qd = data.qvel[self._dof]
         tau = cmd.torque + cmd.kp * (cmd.position - q) + cmd.kd * (cmd.velocity - qd)
-        tau = np.clip(tau, -self._limit, self._limit)
-        overspeed = (np.abs(qd) > self._speed) & (tau * qd > 0)
-        tau[overspeed] = 0.0
+        # clip's min(max()) without np.clip's wrapper (3 of this 15 us, three times a tick)
+        tau = np.minimum(np.maximum(tau, self._negative_limit), self._limit)
+        fast = np.abs(qd) > self._speed
+        if fast.any():  # rarely: skip the rest of the test
+            tau[fast & (tau * qd > 0)] = 0.0
         return tau
 
     def apply(self, data: mujoco.MjData) -> None:

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, SimulationDiverged
-from ridempc.scenarios.scenario import Disturbance, Scenario
+from ridempc.scenarios.scenario import Disturbance, ParameterChange, Scenario
 from ridempc.sim.clock import Rate
 from ridempc.sim.falls import FallDetector
 from ridempc.sim.motors import MotorDriver
@@ -150,6 +150,9 @@ class Simulation:
             controller is not None and type(controller).estimate is not Controller.estimate
         )
         self._pushes = [(self._body_of(d), d) for d in scenario.disturbances]
+        self._changes: dict[int, list[ParameterChange]] = {}  # by the physics step they are due
+        for change in scenario.changes:
+            self._changes.setdefault(round(change.t * hz), []).append(change)
 
     def _body_of(self, disturbance: Disturbance) -> int:
         if disturbance.body == "base":
@@ -176,10 +179,7 @@ class Simulation:
                 data.xfrc_applied[body, 3:] += scale * np.asarray(push.torque)
 
     def _apply_changes(self, tick: int, model: mujoco.MjModel) -> None:
-        hz = self.scene.physics_hz
-        for change in self.scenario.changes:
-            if round(change.t * hz) != tick:
-                continue
+        for change in self._changes.get(tick, ()):
             if change.parameter == "floor_friction":
                 for geom in self.scene.ground_geoms:
                     model.geom_friction[geom, 0] = change.value
@@ -255,9 +255,9 @@ class Simulation:
         bad_acc = data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
         if bad_acc:
             raise SimulationDiverged(t, "MuJoCo reported a bad acceleration (NaN or Inf)")
-        if not np.all(np.isfinite(data.qpos)) or not np.all(np.isfinite(data.qvel)):
+        if not np.isfinite(data.qpos).all() or not np.isfinite(data.qvel).all():
             raise SimulationDiverged(t, "state is not finite")
-        speed = float(np.max(np.abs(data.qvel)))
+        speed = float(np.abs(data.qvel).max())
         if speed > MAX_SPEED:
             raise SimulationDiverged(t, f"a velocity reached {speed:.3g} (limit {MAX_SPEED})")
 
