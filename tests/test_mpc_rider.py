@@ -142,17 +142,20 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
 def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     """Cassie's motor PD follows the WBC at a tenth of its gains (``tracking_gain_scale``);
     with the MPC she then stands on the Hovershoes (at full gains the stiff PD overrode the
-    QP's forces and she fell within 0.8 s)."""
+    QP's forces and she fell within 0.8 s). Her QP weighs the MPC's forces at 1000
+    (``wbc_force_weight``): at 100 the posture task bent her pushes on the shoes and she
+    drifted back at up to 0.17 m/s within 2 s."""
     cassie = load_robot("cassie")
     assert cassie.params.tracking_gain_scale == pytest.approx(0.1)
     rider = MpcRider(cassie, "hovershoes")
     np.testing.assert_allclose(rider.kp, 0.1 * np.array([m.kp for m in cassie.motors]))
+    assert rider.wbc.settings.force_weight == pytest.approx(cassie.params.wbc_force_weight)
     scenario = resolve_scenario("stand-still", "hovershoes").with_duration(2.0)
     scene = build_scene(cassie, DEFAULT_PHYSICS_HZ, board=load_board("hovershoes"))
     result = Simulation(scene, rider, scenario).run()
     assert result.status == "ok", result.fall_reason
     assert rider.summary()["safe_hold"] is None
-    assert np.abs(result.log["forward_velocity"]).max() < 0.3  # [m/s] (a slow drift back)
+    assert np.abs(result.log["forward_velocity"]).max() < 0.12  # [m/s] (a slow drift back)
 
 
 def test_the_frame_follows_the_board_sideways_only(dog) -> None:

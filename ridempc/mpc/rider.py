@@ -141,11 +141,15 @@ class MpcRider(Controller):
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
         # achilles-rod constraint) drives the QP off (see the WBC's tests).
-        # The MPC's forces weigh 100x the WBC's default: their distribution over the feet
-        # is what rolls a deck, and the CoM and orientation tasks leave it free (measured on
-        # roll-tracking: roll RMSE 0.063 rad at 1, 0.048 at 100; 1000 lost the QP).
+        # The MPC's forces weigh ``wbc_force_weight`` (100 by default, 100x the WBC's own
+        # default): their distribution over the feet is what rolls a deck or a platform, and
+        # the CoM and orientation tasks leave it free (the dog's roll-tracking: roll RMSE
+        # 0.063 rad at 1, 0.048 at 100).
         sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
-        settings_wbc = WbcSettings(springs="rigid" if sprung else "passive", force_weight=100.0)
+        settings_wbc = WbcSettings(
+            springs="rigid" if sprung else "passive",
+            force_weight=robot.params.wbc_force_weight,
+        )
         self.wbc = WholeBodyController(
             robot,
             settings_wbc,

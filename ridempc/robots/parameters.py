@@ -80,6 +80,14 @@ class RobotParameters(_Frozen):
             "controller whose torques go out as feedforward (the MPC rider) [-]."
         ),
     )
+    wbc_force_weight: float = Field(
+        default=100.0,
+        gt=0.0,
+        description=(
+            "Weight of the MPC's contact forces in the MPC rider's whole-body QP, per unit "
+            "of whole-body acceleration [(kg/N)^2] (WbcSettings.force_weight)."
+        ),
+    )
 
     @model_validator(mode="after")
     def _contact_sites_unique(self) -> RobotParameters:
