@@ -338,6 +338,23 @@ def test_board_roll_from_two_feet_side_by_side() -> None:
     assert board.position[2] == pytest.approx(0.1)
 
 
+def test_a_line_foot_alone_on_its_platform_gives_the_platform_heading() -> None:
+    """A toe line turned 0.3 rad right of the rider's forward (a Hovershoe that turned
+    under its foot) is the platform's heading; a line across the rider is not."""
+    heading = np.array([np.cos(-0.3), np.sin(-0.3), 0.0])
+    front, back = 0.05 * heading + [0.0, 0.15, 0.11], -0.05 * heading + [0.0, 0.15, 0.11]
+    rider_forward = np.array([1.0, 0.0, 0.0])
+    board = estimate_board(("l",), np.array([front, back]), np.zeros((2, 3)), rider_forward)
+    assert board.yaw == pytest.approx(-0.3, abs=1e-9)
+    assert board.pitch == pytest.approx(0.0, abs=1e-12)
+    backwards = estimate_board(("l",), np.array([back, front]), np.zeros((2, 3)), rider_forward)
+    assert backwards.yaw == pytest.approx(-0.3, abs=1e-9)  # the sign follows the rider
+    across = np.array([[0.0, 0.2, 0.1], [0.0, -0.2, 0.1]])
+    assert estimate_board(("l", "r"), across, np.zeros((2, 3)), heading).yaw == pytest.approx(
+        -0.3, abs=1e-9
+    )
+
+
 def test_feet_on_a_platform_get_a_board_estimate() -> None:
     robot = load_robot("cyberdog2")
     feet = robot.params.foot_bodies

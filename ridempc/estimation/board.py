@@ -9,7 +9,12 @@ stance feet's contact points :math:`c_k` (world, [m]) and velocities:
   points on one line (two point feet, one line foot) the tilt about that line is not
   seen by the feet: the normal is then taken perpendicular to the line and as close to
   ``up_hint`` as possible (the world's z by default, or e.g. a line foot's sole normal);
-- x axis: the rider's forward direction projected on the plane; y = z × x;
+- x axis: along the line of the points when they lie on one line within 45 degrees of the
+  rider's forward direction (a line foot alone on its platform, as Cassie's on a Hovershoe:
+  the sole's toe line turns with the platform it grips), else the rider's forward
+  direction, projected on the plane; y = z × x. Read off the rider's heading alone, a
+  Hovershoe that turned 0.3 rad under its foot was estimated straight ahead (the MPC then
+  never turned it back);
 - yaw, pitch, roll: z-y-x Euler angles of :math:`R_{WP} = [x\\ y\\ z]`; with two feet side
   by side, roll is the slope of the line through them, as in the paper;
 - velocity: the mean of the stance feet's world velocities :math:`\\bar{\\dot c}` [m/s];
@@ -34,18 +39,21 @@ __all__ = ["estimate_board"]
 
 Array = NDArray[np.float64]
 COLLINEAR: float = 1e-3  # [m] RMS distance from the best line below which points are a line
+FORE_AFT: float = math.cos(math.pi / 4)  # a line this aligned with forward gives the heading
 UP: Array = np.array([0.0, 0.0, 1.0])
 UP.flags.writeable = False
 
 
-def _normal(centred: Array, up_hint: Array) -> Array:
-    """The plane's upward unit normal, from the points less their centroid [m]."""
+def _normal(centred: Array, up_hint: Array) -> tuple[Array, Array | None]:
+    """The plane's upward unit normal, from the points less their centroid [m], and the
+    unit direction of their line when they lie on one (else None)."""
     count = len(centred)
     if count >= 2:
         _, singular, vt = svd(centred)
     else:
         singular, vt = np.zeros(1), np.eye(3)
     second = singular[1] if singular.size > 1 else 0.0
+    line = None
     if count >= 3 and second / math.sqrt(count) > COLLINEAR:
         normal = vt[2]
     elif count >= 2 and singular[0] > 0.0:
@@ -54,7 +62,7 @@ def _normal(centred: Array, up_hint: Array) -> Array:
     else:
         normal = up_hint.copy()
     normal /= math.sqrt(normal @ normal)  # np.linalg.norm's sum, without its wrapper
-    return normal if normal[2] >= 0.0 else -normal
+    return (normal if normal[2] >= 0.0 else -normal), line
 
 
 def estimate_board(
@@ -84,8 +92,11 @@ def estimate_board(
     count = len(points)
     centre = points.sum(axis=0) / count  # np.mean's own sum and division, not its wrapper
     centred = points - centre
-    z_axis = _normal(centred, hint)
-    x_axis = forward - z_axis * (z_axis @ forward)
+    z_axis, line = _normal(centred, hint)
+    heading = forward
+    if line is not None and abs(line @ forward) >= FORE_AFT * math.sqrt(forward @ forward):
+        heading = line if line @ forward > 0.0 else -line
+    x_axis = heading - z_axis * (z_axis @ heading)
     norm = math.sqrt(x_axis @ x_axis)
     if norm < 1e-6:
         raise ValueError("the rider's forward direction is normal to the board")
