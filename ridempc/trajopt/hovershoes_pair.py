@@ -4,4 +4,4 @@ from ridempc.trajopt.ride_pair import make_ride_pair
 
 __all__ = ["PAIR"]
 
-PAIR = make_ride_pair("cassie", "hovershoes", default_targets=(0.5, 1.0))
+PAIR = make_ride_pair("cassie", "hovershoes", default_targets=(0.5, 1.0, 1.5))
