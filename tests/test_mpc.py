@@ -467,3 +467,34 @@ def test_a_commanded_roll_moves_the_reference_to_a_balance(skate_mpc: LinearMpc)
     np.testing.assert_allclose(
         (a_c @ shift.velocities)[names["com_y"]], shift.states[names["com_y"]], rtol=1e-6
     )
+
+
+def test_a_commanded_turn_lays_an_arc_over_the_reference() -> None:
+    """``with_turn``: no rate leaves the problem as it is; 0.5 rad/s turns every heading by
+    0.5 k dt, adds the rate to the yaw rates, and turns the velocity and the position
+    steps with it (speeds and step lengths kept)."""
+    mpc = LinearMpc.from_library("cassie", "hovershoes", "accelerate", 1.0)
+    layout = StateLayout.from_names(mpc.reference.state_names)
+    n = layout.names
+    problem = mpc.problem(5.0, mpc.reference.sample(5.0, 0, 1.0).states[0])
+    steps = problem.state_reference.shape[0] - 1
+    assert ManoeuvreSelector.with_turn(problem, layout, np.zeros(steps)) is problem
+    turned = ManoeuvreSelector.with_turn(problem, layout, np.full(steps, 0.5), 0.1)
+    before, after = problem.state_reference, turned.state_reference
+    angle = 0.1 + 0.5 * problem.dt * np.arange(steps + 1)
+    for name in ("left_psi", "right_psi", "pelvis_yaw"):
+        np.testing.assert_allclose(after[:, n[name]] - before[:, n[name]], angle, atol=1e-12)
+    for name in ("left_psi_dot", "right_psi_dot", "wz"):
+        np.testing.assert_allclose(after[:, n[name]] - before[:, n[name]], 0.5, atol=1e-12)
+    speed = np.hypot(after[:, n["vx"]], after[:, n["vy"]])
+    np.testing.assert_allclose(speed, np.hypot(before[:, n["vx"]], before[:, n["vy"]]))
+    heading = np.arctan2(after[:, n["vy"]], after[:, n["vx"]])
+    np.testing.assert_allclose(heading, angle, atol=1e-6)  # riding straight along x before
+    for prefix in ("com_", "left_"):
+        xy = after[:, [n[f"{prefix}x"], n[f"{prefix}y"]]]
+        lengths = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+        original = np.linalg.norm(
+            np.diff(before[:, [n[f"{prefix}x"], n[f"{prefix}y"]]], axis=0), axis=1
+        )
+        np.testing.assert_allclose(lengths, original, atol=1e-12)
+        np.testing.assert_allclose(xy[0], before[0, [n[f"{prefix}x"], n[f"{prefix}y"]]])

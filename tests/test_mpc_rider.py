@@ -181,3 +181,11 @@ def test_the_frame_follows_the_board_sideways_only(dog) -> None:
         gap_before = before[n[f"com_{axis}"]] - before[n[f"board_{axis}"]]
         assert after[n[f"com_{axis}"]] - after[n[f"board_{axis}"]] == pytest.approx(gap_before)
     assert after[n["board_yaw"]] == pytest.approx(before[n["board_yaw"]])
+
+
+def test_turns_are_laid_over_the_boards_the_rider_can_turn() -> None:
+    """A Hovershoe turns under the feet's yaw torque; the Segway only by its knee bar, which
+    the rider does not push (pinned), so a yaw-rate command is not laid over its reference."""
+    cassie = load_robot("cassie")
+    assert MpcRider(cassie, "hovershoes").steers
+    assert not MpcRider(cassie, "segway").steers

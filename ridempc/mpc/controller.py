@@ -137,6 +137,25 @@ class LinearMpc:
         self._fixed = self._fixed_indices(fixed)
         self.settings = replace(self.settings, fixed_inputs=fixed)
 
+    def steers(self, patterns: tuple[str, ...] = ("_psi_dot", "_yaw_rate")) -> bool:
+        """Whether an input that is not held drives a board's yaw rate directly
+        (:math:`\\partial \\dot x / \\partial u \\ne 0` at the reference's start on a state
+        named ``*_psi_dot`` or ``*_yaw_rate``): a Hovershoe turns under the feet's yaw
+        torque, a Segway only by its knee bar, which a pinned bar cannot."""
+        names = self.reference.state_names
+        rows = [i for i, n in enumerate(names) if n.endswith(patterns)]
+        free = [
+            i
+            for i, n in enumerate(self.reference.input_names)
+            if n not in self.settings.fixed_inputs
+        ]
+        if not rows or not free:
+            return False
+        _, _, jac_u = self.model.jacobians(
+            self.reference.states[0], self.reference.inputs[0], self.reference.parameters[0]
+        )
+        return bool(np.any(np.abs(np.asarray(jac_u)[np.ix_(rows, free)]) > 1e-9))
+
     @classmethod
     def from_library(
         cls,

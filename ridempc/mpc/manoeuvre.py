@@ -203,6 +203,51 @@ class ManoeuvreSelector:
         return now - t_match
 
     @staticmethod
+    def with_turn(
+        problem: MpcProblem, layout: StateLayout, rates: Array, turned: float = 0.0
+    ) -> MpcProblem:
+        """The problem's reference turned at the commanded yaw rates :math:`\\omega^*_k`
+        [rad/s] over the horizon's steps (unchanged when all are zero).
+
+        With :math:`\\Delta\\psi_k = \\sum_{j<k} \\omega^*_j \\Delta t` the heading
+        turned by node :math:`k`, every heading (the platforms' and the base's yaw) gains
+        :math:`\\Delta\\psi_k`, every yaw rate (the platforms' and the base's
+        :math:`\\omega_z`, level base) gains :math:`\\omega^*_k`, and the horizontal
+        velocity and the steps of every horizontal position (the centre of mass's, each
+        platform's) are turned by :math:`R_z(\\Delta\\psi_k)` about node 0: the reference
+        rides the arc the command asks for. ``turned`` [rad] is the turn commanded so far
+        (the rider integrates the command), added to every node: the heading is tracked,
+        and a turn once made is kept when the command ends.
+        """
+        rates = np.asarray(rates, dtype=float)
+        if not np.any(rates) and turned == 0.0:
+            return problem
+        names = layout.names
+        states = problem.state_reference.copy()
+        ahead = np.cumsum(rates[: states.shape[0] - 1] * problem.dt)
+        turned_k = turned + np.concatenate([[0.0], ahead])
+        step_rates = np.concatenate([rates[: states.shape[0] - 1], rates[-1:]])[: len(turned_k)]
+        cos, sin = np.cos(turned_k), np.sin(turned_k)
+        for prefix in ("com_", *layout.prefixes):
+            ix, iy = names[f"{prefix}x"], names[f"{prefix}y"]
+            steps = np.diff(states[:, [ix, iy]], axis=0)
+            c, s = cos[:-1], sin[:-1]
+            rotated = np.column_stack(
+                [c * steps[:, 0] - s * steps[:, 1], s * steps[:, 0] + c * steps[:, 1]]
+            )
+            states[1:, ix] = states[0, ix] + np.cumsum(rotated[:, 0])
+            states[1:, iy] = states[0, iy] + np.cumsum(rotated[:, 1])
+        vx, vy = states[:, names["vx"]].copy(), states[:, names["vy"]].copy()
+        states[:, names["vx"]] = cos * vx - sin * vy
+        states[:, names["vy"]] = sin * vx + cos * vy
+        for name, index in names.items():
+            if name.endswith(("_yaw", "_psi")):
+                states[:, index] += turned_k
+            elif name.endswith(("_psi_dot", "_yaw_rate")) or name == "wz":
+                states[:, index] += step_rates
+        return replace(problem, state_reference=states)
+
+    @staticmethod
     def commands_roll(names: dict[str, int], roll: Array) -> bool:
         """Whether the commanded deck roll over the horizon, ``roll`` [rad], sets a roll the
         reference has (a pair with a ``board_roll`` state, a roll that is not all zero)."""

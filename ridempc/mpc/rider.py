@@ -134,6 +134,10 @@ class MpcRider(Controller):
         names = self.mpc.reference.input_names
         pinned = {n: 0.0 for n in UNREALISED_INPUTS if n in names}
         self.mpc.fix_inputs({**pinned, **self.mpc.settings.fixed_inputs})
+        # Yaw-rate commands are laid over the reference only where the rider can turn the
+        # board (not the Segway with its knee bar pinned: it rode yaw-steps straight, and
+        # with the turn laid over it fell at 7.7 s).
+        self.steers = self.mpc.steers()
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_names(reference.state_names)
@@ -176,6 +180,9 @@ class MpcRider(Controller):
         self._last_problem: MpcProblem | None = None
         self._plan_time = 0.0
         self._command_roll: tuple[float, float] | None = None
+        self._turned = 0.0  # [rad] the commanded yaw rate integrated over the ride
+        self._turn_time: float | None = None
+        self._turn_rate = 0.0
         self._hold: MotorCommand | None = None
         self._last_command: MotorCommand | None = None
         self._wbc_misses = 0  # consecutive
@@ -270,7 +277,16 @@ class MpcRider(Controller):
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
         line = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
-        self.map.follow_sideways(estimate, self.layout.board_pose(line))
+        turn = self._yaw_rate_horizon(command, now)
+        if self._turn_time is not None:
+            self._turned += self._turn_rate * (now - self._turn_time)
+        self._turn_time, self._turn_rate = now, float(turn[0])
+        line = line.copy()
+        for name, index in self.layout.names.items():
+            if name.endswith(("_yaw", "_psi")):
+                line[index] += self._turned
+        turning = bool(np.any(turn)) or self._turned != 0.0
+        self.map.follow_sideways(estimate, self.layout.board_pose(line), along=turning)
         x0 = self.map.state(estimate)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
@@ -279,6 +295,7 @@ class MpcRider(Controller):
         if self.selector.commands_roll(names, roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
+        problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem
@@ -324,6 +341,17 @@ class MpcRider(Controller):
         if previous is not None and now > previous[0]:
             rate = (command.roll - previous[1]) / (now - previous[0])
         return np.asarray(command.roll + rate * (times - now), dtype=float)
+
+    def _yaw_rate_horizon(self, command: Command, now: float) -> Array:
+        """The commanded yaw rate over the horizon's steps [rad/s], read ahead from the
+        ``command_preview`` when the ride's commands are planned, else the present one."""
+        settings = self.mpc.settings
+        if not self.steers:
+            return np.zeros(settings.horizon)
+        times = now + settings.dt * np.arange(settings.horizon)
+        if self.command_preview is not None:
+            return np.array([self.command_preview(float(t)).yaw_rate for t in times])
+        return np.full(settings.horizon, float(command.yaw_rate))
 
     def _speed(self, estimate: EstimatedState) -> float:
         if estimate.boards:

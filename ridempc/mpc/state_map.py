@@ -234,7 +234,10 @@ class StateMap:
         self.frame = PlanarFrame(dyaw, offset)
 
     def follow_sideways(
-        self, estimate: EstimatedState, board_pose: tuple[float, float, float]
+        self,
+        estimate: EstimatedState,
+        board_pose: tuple[float, float, float],
+        along: bool = False,
     ) -> float:
         """Shift the frame across the reference's heading so that platform 0's estimate
         lies on the reference's line: its cross-track offset
@@ -248,6 +251,8 @@ class StateMap:
         the Segway 0.1 m off the reference's line in 5 s, and the MPC, holding the
         rider's centre of mass on that line, leaned Cassie off her platform (velocity
         steps fell at 26.4 s). Offsets between the rider and the board are unchanged.
+        With ``along`` the offset along the line is taken out too (while turning: the
+        reference's straight line is not the arc the board rides).
 
         Returns:
             The shift :math:`e` [m] (0 without a board estimate).
@@ -257,8 +262,12 @@ class StateMap:
         x_ref, y_ref, yaw_ref = board_pose
         p_lib = self.frame.point_to_library(estimate.boards[0].position)
         normal = np.array([-math.sin(yaw_ref), math.cos(yaw_ref), 0.0])
-        error = float(normal[:2] @ (p_lib[:2] - np.array([x_ref, y_ref])))
-        shift = self.frame.vector_to_world(error * normal)
+        gap = p_lib[:2] - np.array([x_ref, y_ref])
+        error = float(normal[:2] @ gap)
+        moved = error * normal
+        if along:
+            moved[:2] = gap
+        shift = self.frame.vector_to_world(moved)
         offset = (self.frame.offset[0] + float(shift[0]), self.frame.offset[1] + float(shift[1]))
         self.frame = PlanarFrame(self.frame.yaw, offset)
         return error
