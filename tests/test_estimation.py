@@ -340,19 +340,23 @@ def test_board_roll_from_two_feet_side_by_side() -> None:
 
 def test_a_line_foot_alone_on_its_platform_gives_the_platform_heading() -> None:
     """A toe line turned 0.3 rad right of the rider's forward (a Hovershoe that turned
-    under its foot) is the platform's heading; a line across the rider is not."""
+    under its foot) is its own platform's heading; a line across the rider is not, nor one
+    foot's line on a platform it shares."""
     heading = np.array([np.cos(-0.3), np.sin(-0.3), 0.0])
     front, back = 0.05 * heading + [0.0, 0.15, 0.11], -0.05 * heading + [0.0, 0.15, 0.11]
     rider_forward = np.array([1.0, 0.0, 0.0])
-    board = estimate_board(("l",), np.array([front, back]), np.zeros((2, 3)), rider_forward)
+    points, still = np.array([front, back]), np.zeros((2, 3))
+    board = estimate_board(("l",), points, still, rider_forward, own_platform=True)
     assert board.yaw == pytest.approx(-0.3, abs=1e-9)
     assert board.pitch == pytest.approx(0.0, abs=1e-12)
-    backwards = estimate_board(("l",), np.array([back, front]), np.zeros((2, 3)), rider_forward)
+    backwards = estimate_board(("l",), points[::-1], still, rider_forward, own_platform=True)
     assert backwards.yaw == pytest.approx(-0.3, abs=1e-9)  # the sign follows the rider
+    # one foot of two left in stance on a shared platform says nothing of its heading
+    shared = estimate_board(("l",), points, still, rider_forward, own_platform=False)
+    assert shared.yaw == pytest.approx(0.0, abs=1e-9)
     across = np.array([[0.0, 0.2, 0.1], [0.0, -0.2, 0.1]])
-    assert estimate_board(("l", "r"), across, np.zeros((2, 3)), heading).yaw == pytest.approx(
-        -0.3, abs=1e-9
-    )
+    sideways = estimate_board(("l", "r"), across, still, heading, own_platform=True)
+    assert sideways.yaw == pytest.approx(-0.3, abs=1e-9)
 
 
 def test_feet_on_a_platform_get_a_board_estimate() -> None:

@@ -9,12 +9,14 @@ stance feet's contact points :math:`c_k` (world, [m]) and velocities:
   points on one line (two point feet, one line foot) the tilt about that line is not
   seen by the feet: the normal is then taken perpendicular to the line and as close to
   ``up_hint`` as possible (the world's z by default, or e.g. a line foot's sole normal);
-- x axis: along the line of the points when they lie on one line within 45 degrees of the
-  rider's forward direction (a line foot alone on its platform, as Cassie's on a Hovershoe:
-  the sole's toe line turns with the platform it grips), else the rider's forward
-  direction, projected on the plane; y = z × x. Read off the rider's heading alone, a
-  Hovershoe that turned 0.3 rad under its foot was estimated straight ahead (the MPC then
-  never turned it back);
+- x axis: for a line foot alone on its platform (``own_platform``, as Cassie's on a
+  Hovershoe), along the line of its points when they lie within 45 degrees of the rider's
+  forward direction (the sole's toe line turns with the platform it grips), else the
+  rider's forward direction, projected on the plane; y = z × x. Read off the rider's
+  heading alone, a Hovershoe that turned 0.3 rad under its foot was estimated straight
+  ahead (the MPC then never turned it back). Not for one foot of several left in stance on
+  a platform (a Segway's, for a moment): its toe line is not the platform's heading, and
+  reading it there made the Segway ride fall at 19.6 s instead of 32.7 s;
 - yaw, pitch, roll: z-y-x Euler angles of :math:`R_{WP} = [x\\ y\\ z]`; with two feet side
   by side, roll is the slope of the line through them, as in the paper;
 - velocity: the mean of the stance feet's world velocities :math:`\\bar{\\dot c}` [m/s];
@@ -71,6 +73,7 @@ def estimate_board(
     velocities: Array,
     forward: Array,
     up_hint: Array | None = None,
+    own_platform: bool = False,
 ) -> BoardEstimate:
     """The platform state from the points of the feet on it.
 
@@ -80,6 +83,8 @@ def estimate_board(
         velocities: World velocity of each point [m/s], shape (points, 3).
         forward: The rider's forward direction in the world (e.g. the base x axis).
         up_hint: Normal to use about a line of points (default world z).
+        own_platform: The points are one foot's, alone on its platform: their line, if
+            fore and aft, gives the heading.
 
     Raises:
         ValueError: No points, or ``forward`` is along the normal.
@@ -94,7 +99,8 @@ def estimate_board(
     centred = points - centre
     z_axis, line = _normal(centred, hint)
     heading = forward
-    if line is not None and abs(line @ forward) >= FORE_AFT * math.sqrt(forward @ forward):
+    fore_aft = line is not None and abs(line @ forward) >= FORE_AFT * math.sqrt(forward @ forward)
+    if own_platform and line is not None and fore_aft:
         heading = line if line @ forward > 0.0 else -line
     x_axis = heading - z_axis * (z_axis @ heading)
     norm = math.sqrt(x_axis @ x_axis)

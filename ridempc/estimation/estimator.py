@@ -117,7 +117,7 @@ class StateEstimator:
         self._platform_sites = tuple(
             np.isin(self.legs.site_foot, [feet.index(f) for f in group]) for group in self.platforms
         )
-        self._board_feet_cache: dict[bytes, tuple[tuple[tuple[str, ...], Index], ...]] = {}
+        self._board_feet_cache: dict[bytes, tuple[tuple[tuple[str, ...], Index, bool], ...]] = {}
         self.contact: ContactDetector = build_contact_detector(
             robot, self.pinocchio, self.legs, self.params
         )
@@ -254,10 +254,13 @@ class StateEstimator:
         )
         self.history.shift_after(vio.stamp, correction)
 
-    def _board_feet(self, stance: NDArray[np.bool_]) -> tuple[tuple[tuple[str, ...], Index], ...]:
-        """Per platform, the feet that say where it is and the rows of their contact sites:
-        the feet on it, and of those the ones in contact if any is. Cached per contact and
-        support pattern (at most 4^feet): selecting them anew cost 20 us a tick."""
+    def _board_feet(
+        self, stance: NDArray[np.bool_]
+    ) -> tuple[tuple[tuple[str, ...], Index, bool], ...]:
+        """Per platform, the feet that say where it is, the rows of their contact sites and
+        whether the platform carries one foot only: the feet on it, and of those the ones in
+        contact if any is. Cached per contact and support pattern (at most 4^feet):
+        selecting them anew cost 20 us a tick."""
         key = stance.tobytes() + self._on_ground.tobytes()
         selection = self._board_feet_cache.get(key)
         if selection is None:
@@ -266,12 +269,13 @@ class StateEstimator:
             in_stance = stance & on_board
             chosen = []
             for group, sites in zip(self.platforms, self._platform_sites, strict=True):
+                alone = len(group) == 1
                 for reading in (in_stance, on_board):
                     if np.any(sites & reading[site_foot]):
                         sites = sites & reading[site_foot]
                         group = tuple(f for f in group if reading[names.index(f)])
                         break
-                chosen.append((group, np.flatnonzero(sites)))
+                chosen.append((group, np.flatnonzero(sites), alone))
             selection = self._board_feet_cache[key] = tuple(chosen)
         return selection
 
@@ -297,8 +301,9 @@ class StateEstimator:
                 base_position + legs.site_position[rows],
                 base_velocity + legs.site_velocity[rows],
                 forward=attitude.rotation[:, 0],
+                own_platform=alone,
             )
-            for group, rows in self._board_feet(stance)
+            for group, rows, alone in self._board_feet(stance)
         )
         return EstimatedState(
             time=time,
