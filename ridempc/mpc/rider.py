@@ -276,17 +276,8 @@ class MpcRider(Controller):
             self.manoeuvre = replace(wanted, start=start)
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
-        line = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
         turn = self._yaw_rate_horizon(command, now)
-        if self._turn_time is not None:
-            self._turned += self._turn_rate * (now - self._turn_time)
-        self._turn_time, self._turn_rate = now, float(turn[0])
-        line = line.copy()
-        for name, index in self.layout.names.items():
-            if name.endswith(("_yaw", "_psi")):
-                line[index] += self._turned
-        turning = bool(np.any(turn)) or self._turned != 0.0
-        self.map.follow_sideways(estimate, self.layout.board_pose(line), along=turning)
+        self._follow_board(estimate, t_ref, turn, now)
         x0 = self.map.state(estimate)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
@@ -310,6 +301,21 @@ class MpcRider(Controller):
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
+
+    def _follow_board(
+        self, estimate: EstimatedState, t_ref: float, turn: Array, now: float
+    ) -> None:
+        """Integrate the commanded turn and move the library frame onto the board: across
+        the reference's line (turned by the turn so far), and along it too while turning."""
+        if self._turn_time is not None:
+            self._turned += self._turn_rate * (now - self._turn_time)
+        self._turn_time, self._turn_rate = now, float(turn[0])
+        line = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
+        for name, index in self.layout.names.items():
+            if name.endswith(("_yaw", "_psi")):
+                line[index] += self._turned
+        turning = bool(np.any(turn)) or self._turned != 0.0
+        self.map.follow_sideways(estimate, self.layout.board_pose(line), along=turning)
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
         """Where each foot is over this MPC step, from the schedule's contacts: on the ground
