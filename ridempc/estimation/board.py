@@ -99,9 +99,10 @@ def estimate_board(
     centred = points - centre
     z_axis, line = _normal(centred, hint)
     heading = forward
-    fore_aft = line is not None and abs(line @ forward) >= FORE_AFT * math.sqrt(forward @ forward)
-    if own_platform and line is not None and fore_aft:
-        heading = line if line @ forward > 0.0 else -line
+    if own_platform and line is not None:
+        along = line @ forward
+        if abs(along) >= FORE_AFT * math.sqrt(forward @ forward):
+            heading = line if along > 0.0 else -line
     x_axis = heading - z_axis * (z_axis @ heading)
     norm = math.sqrt(x_axis @ x_axis)
     if norm < 1e-6:

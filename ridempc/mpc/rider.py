@@ -310,12 +310,9 @@ class MpcRider(Controller):
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])
-        line = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
-        for name, index in self.layout.names.items():
-            if name.endswith(("_yaw", "_psi")):
-                line[index] += self._turned
+        x, y, heading = self.layout.board_pose(self.mpc.reference.sample(t_ref, 0, 1.0).states[0])
         turning = bool(np.any(turn)) or self._turned != 0.0
-        self.map.follow_sideways(estimate, self.layout.board_pose(line), along=turning)
+        self.map.follow_sideways(estimate, (x, y, heading + self._turned), along=turning)
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
         """Where each foot is over this MPC step, from the schedule's contacts: on the ground
@@ -339,8 +336,9 @@ class MpcRider(Controller):
         tracks a moving command one step late."""
         nodes = problem.state_reference.shape[0]
         times = now + problem.dt * np.arange(nodes)
-        if self.command_preview is not None:
-            return np.array([self.command_preview(float(t)).roll for t in times])
+        planned = self._planned("roll", times)
+        if planned is not None:
+            return planned
         previous = self._command_roll
         self._command_roll = (now, command.roll)
         rate = 0.0
@@ -354,10 +352,17 @@ class MpcRider(Controller):
         settings = self.mpc.settings
         if not self.steers:
             return np.zeros(settings.horizon)
-        times = now + settings.dt * np.arange(settings.horizon)
-        if self.command_preview is not None:
-            return np.array([self.command_preview(float(t)).yaw_rate for t in times])
+        planned = self._planned("yaw_rate", now + settings.dt * np.arange(settings.horizon))
+        if planned is not None:
+            return planned
         return np.full(settings.horizon, float(command.yaw_rate))
+
+    def _planned(self, field: str, times: NDArray[np.floating[Any]]) -> Array | None:
+        """One field of the ride's planned commands at ``times`` [s] (``command_preview``),
+        or None when the commands are not planned ahead."""
+        if self.command_preview is None:
+            return None
+        return np.array([getattr(self.command_preview(float(t)), field) for t in times])
 
     def _speed(self, estimate: EstimatedState) -> float:
         if estimate.boards:

@@ -73,12 +73,18 @@ TRACKED_POINTS: dict[str, type[TranslationTask]] = {
 GRAVITY: float = 9.81  # [m] / [s]^2
 
 
+def _motor_q(pinocchio: PinocchioRobot, robot: Robot) -> NDArray[np.int64]:
+    """Each motor joint's index in Pinocchio's configuration, actuator order."""
+    model = pinocchio.model
+    return np.array(
+        [model.joints[model.getJointId(m.joint)].idx_q for m in robot.motors], dtype=np.int64
+    )
+
+
 def motor_posture(pinocchio: PinocchioRobot, robot: Robot, qpos: Array) -> Array:
     """The motor joint angles [rad] of a MuJoCo configuration ``qpos``, actuator order (a
     posture for :class:`WholeBodyController`)."""
-    model = pinocchio.model
-    q = pinocchio.coordinates.qpos_to_pinocchio(qpos)
-    return np.array([q[model.joints[model.getJointId(m.joint)].idx_q] for m in robot.motors])
+    return pinocchio.coordinates.qpos_to_pinocchio(qpos)[_motor_q(pinocchio, robot)]
 
 
 class WholeBodyController:
@@ -113,14 +119,10 @@ class WholeBodyController:
         self.platforms = tuple(platforms)
         self.settings = settings or WbcSettings()
         self.model = WholeBodyModel(robot, pinocchio)
-        model = self.model.model
-        self.motor_q = np.array(
-            [model.joints[model.getJointId(m.joint)].idx_q for m in robot.motors], dtype=np.int64
-        )
+        self.motor_q = _motor_q(self.model.pinocchio, robot)
         self.motor_v = self.model.motor_v
-        if posture is None:
-            posture = motor_posture(self.model.pinocchio, robot, robot.stand_qpos)
-        self.posture = np.asarray(posture, dtype=float)
+        stand = self.model.pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
+        self.posture = np.asarray(stand[self.motor_q] if posture is None else posture, dtype=float)
         if self.posture.shape != (len(robot.motors),):
             raise ConfigError(
                 f"WBC: posture has {self.posture.size} angles, robot '{robot.name}' has "
@@ -129,7 +131,6 @@ class WholeBodyController:
         self.qp = WholeBodyQP(
             self.model.layout, self._tasks(), self._constraints(), self.settings.osqp
         )
-        stand = self.model.pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
         for problem in self._probe_problems(stand):
             self.qp.include_pattern(problem)
         site_foot = self.model.site_foot
