@@ -372,10 +372,14 @@ def test_feet_on_a_platform_get_a_board_estimate() -> None:
     assert abs(board.roll) < 0.02 and abs(board.pitch) < 0.02  # standing on flat ground
     assert board.position[2] == pytest.approx(0.019, abs=0.01)  # the ball feet's centres
     assert np.linalg.norm(board.velocity) < 0.05
-    # a foot put on the ground (a push-off) leaves the board's estimate, then comes back
+    # a foot put on the ground (a push-off) leaves the board's estimate, then comes back;
+    # the origin stays where the four feet put it (the three feet's centroid is 6 cm off)
     estimator.set_support(["RL_foot"])
     state = estimator.update(controller.packets[-1])
     assert state.board is not None and state.board.feet == ("FL_foot", "FR_foot", "RR_foot")
+    assert np.linalg.norm(state.board.position - board.position) < 2e-3
+    three = np.array([state.foot_position[feet.index(f)] for f in state.board.feet])
+    assert np.linalg.norm(three.mean(axis=0)[:2] - board.position[:2]) > 0.04
     estimator.set_support([])
     assert estimator.update(controller.packets[-1]).board.feet == feet
     with pytest.raises(ConfigError, match="'RL_paw' is not a foot"):

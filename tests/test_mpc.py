@@ -498,3 +498,68 @@ def test_a_commanded_turn_lays_an_arc_over_the_reference() -> None:
         )
         np.testing.assert_allclose(lengths, original, atol=1e-12)
         np.testing.assert_allclose(xy[0], before[0, [n[f"{prefix}x"], n[f"{prefix}y"]]])
+
+
+def test_swing_targets_follow_the_reference_feet_carried_by_the_board(
+    skate_mpc: LinearMpc,
+) -> None:
+    """The reference's feet stand on the deck at rest and on the ground while pushing, and
+    the targets move with the estimated board, not with the trunk."""
+    from ridempc.estimation.state import BoardEstimate
+    from ridempc.mpc.state_map import PlanarFrame
+    from ridempc.mpc.swing import ReferenceFeet
+    from ridempc.robots import load_robot
+    from ridempc.trajopt.skate_pair import skate_models
+    from ridempc.wbc.model import WholeBodyModel
+
+    reference = skate_mpc.reference
+    layout = StateLayout.from_names(reference.state_names)
+    model = WholeBodyModel(load_robot("cyberdog2"))
+    feet = ReferenceFeet(model, reference.state_names, layout.base_prefix, layout.board_pose)
+    assert feet.plans_feet
+    robot, board = skate_models()
+    radius = float(np.mean(robot.foot_radius))
+    on_deck = feet.points(reference.states[0])[:, 2]
+    assert np.ptp(on_deck) < 2e-3 and on_deck[0] == pytest.approx(
+        board.deck_height + radius, abs=5e-3
+    )
+    pusher = model.foot_names.index("RL_foot")
+    pushing = [k for k, step in enumerate(reference.schedule) if step[pusher] is Contact.GROUND]
+    middle = reference.times[pushing[len(pushing) // 2]]
+    state = reference.sample(float(middle), 0, 1.0).states[0]
+    assert feet.points(state)[pusher, 2] == pytest.approx(radius, abs=5e-3)
+    # carried: a board 0.1 m ahead and 0.05 m left of the reference's carries every target
+    x_b, y_b, psi_b = layout.board_pose(state)
+    moved = BoardEstimate(
+        feet=(),
+        position=np.array([x_b + 0.1, y_b + 0.05, 0.1]),
+        yaw=psi_b,
+        pitch=0.0,
+        roll=0.0,
+        velocity=np.array([0.5, 0.0, 0.0]),
+        yaw_rate=0.0,
+    )
+    frame = PlanarFrame()
+    at_plan, _ = feet.targets(reference, float(middle), frame, None)
+    carried, velocity = feet.targets(reference, float(middle), frame, moved)
+    assert carried - at_plan == pytest.approx(np.tile([0.1, 0.05, 0.0], (4, 1)), abs=1e-9)
+    assert np.all(np.isfinite(velocity))
+
+
+def test_a_library_floor_on_deck_forces_is_the_mpcs_too(skate_mpc: LinearMpc) -> None:
+    """The library's least deck force (options.min_board_force, per foot's weight share)
+    bounds the MPC's normal forces on the deck, never on the ground or a swinging foot."""
+    share = skate_mpc.reference.min_board_share
+    assert share > 0.0
+    problem = skate_mpc.problem(0.0, skate_mpc.reference.states[0])
+    least = share * skate_mpc.pair.weight / len(skate_mpc.reference.force_index)
+    normals = problem.constraint_lower[:, ::ROWS_PER_CONTACT]
+    for step, contacts in zip(normals, problem.contacts, strict=True):
+        for value, kind in zip(step, contacts, strict=True):
+            assert value == pytest.approx(least if kind is Contact.BOARD else 0.0)
+    # and every stance foot on the deck carries it in the library itself
+    reference = skate_mpc.reference
+    for k, contacts in enumerate(reference.schedule):
+        for i, kind in enumerate(contacts):
+            if kind is Contact.BOARD:
+                assert reference.inputs[k, reference.force_index[i][2]] >= least - 1e-3

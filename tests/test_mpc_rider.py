@@ -104,8 +104,8 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
 
 
 def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> None:
-    """The schedule's swing foot gets a swing target from the plan's joint angles, and
-    while it pushes it stands on the ground: out of the deck's estimate, not a fall."""
+    """The schedule's swing foot follows the reference's foot down to the ground, on time,
+    and while it pushes it stands on the ground: out of the deck's estimate, not a fall."""
     rider = MpcRider(dog, "skateboard")
     scenario = resolve_scenario("push-off-0.7", "skateboard").with_duration(1.8)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
@@ -137,6 +137,34 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
         mujoco.mj_kinematics(scene.model, scene_data)
         heights.append(scene_data.site_xpos[site.id][2])
     assert min(heights) < 0.03  # [m] the foot reached the ground (the deck is 0.11 m up)
+    # on time: down before the schedule's push ends its first tenth (the reference's foot)
+    times = np.asarray(result.log["time"])
+    first_push = min(s[0] for s in pushing)
+    assert min(h for t, h in zip(times, heights, strict=True) if t < first_push + 0.05) < 0.03
+    # the deck feet stay where they stood on the deck through the lift and the push (with
+    # the swing target read off the plan at the estimated trunk, the touchdown slid two of
+    # them 5-7 cm across the deck)
+    drift = _deck_foot_drift(scene, result.log, ("FL_contact", "FR_contact", "RR_contact"))
+    assert max(drift.values()) < 0.015, drift  # [m]
+
+
+def _deck_foot_drift(scene, log, sites: tuple[str, ...]) -> dict[str, float]:
+    """Largest move of each site over the deck in the board's frame [m] (planar)."""
+    data = mujoco.MjData(scene.model)
+    start: dict[str, np.ndarray] = {}
+    drift = dict.fromkeys(sites, 0.0)
+    for qpos, position, quaternion in zip(
+        log["qpos"], log["board_position"][:, 0], log["board_quaternion"][:, 0], strict=True
+    ):
+        data.qpos[: qpos.size] = qpos
+        mujoco.mj_kinematics(scene.model, data)
+        rotation = np.zeros(9)
+        mujoco.mju_quat2Mat(rotation, quaternion)
+        for name in sites:
+            local = rotation.reshape(3, 3).T @ (data.site(name).xpos - position)
+            start.setdefault(name, local[:2])
+            drift[name] = max(drift[name], float(np.linalg.norm(local[:2] - start[name])))
+    return drift
 
 
 def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:

@@ -3,7 +3,12 @@
 The feet standing on a board move with it, so the board's platform frame is read off the
 stance feet's contact points :math:`c_k` (world, [m]) and velocities:
 
-- origin: their centroid :math:`\\bar c`;
+- origin: their centroid :math:`\\bar c`, less ``footprint`` :math:`o` (in the platform
+  frame) when only some of the platform's feet stand on it:
+  :math:`p = \\bar c - R_{WP}\\, o`, with :math:`o` the centroid of those feet's points as
+  last seen with every foot down, relative to the centroid of all of them. Without it the
+  origin moved with the feet: a dog lifting one hind foot moved its deck's estimate
+  6 cm forward and 3 cm sideways, and back when the foot came down;
 - normal :math:`n`: the least-squares plane through the points (the right singular vector
   of the centred points with the smallest singular value), turned upward. With the
   points on one line (two point feet, one line foot) the tilt about that line is not
@@ -74,6 +79,7 @@ def estimate_board(
     forward: Array,
     up_hint: Array | None = None,
     own_platform: bool = False,
+    footprint: Array | None = None,
 ) -> BoardEstimate:
     """The platform state from the points of the feet on it.
 
@@ -110,7 +116,9 @@ def estimate_board(
     x_axis /= norm
     y_axis = np.empty(3)
     mujoco.mju_cross(y_axis, z_axis, x_axis)  # np.cross costs 30 us on 3-vectors, this 1
-    roll, pitch, yaw = rpy_of_matrix(np.array((x_axis, y_axis, z_axis)).T)
+    rotation = np.array((x_axis, y_axis, z_axis)).T
+    roll, pitch, yaw = rpy_of_matrix(rotation)
+    origin = centre if footprint is None else centre - rotation @ footprint
     mean_velocity = velocities.sum(axis=0) / count
     r = centred[:, :2]
     r_dot = (velocities - mean_velocity)[:, :2]
@@ -122,7 +130,7 @@ def estimate_board(
     )
     return BoardEstimate(
         feet=feet,
-        position=centre,
+        position=origin,
         yaw=yaw,
         pitch=pitch,
         roll=roll,

@@ -44,7 +44,8 @@ from ridempc.estimation.leg_odometry import LegOdometryModel
 from ridempc.estimation.legs import LegKinematics, LegReading
 from ridempc.estimation.loop_closure import LoopClosure
 from ridempc.estimation.parameters import EstimatorParameters
-from ridempc.estimation.state import EstimatedState, JointValues
+from ridempc.estimation.rotations import matrix_of_rpy
+from ridempc.estimation.state import BoardEstimate, EstimatedState, JointValues
 from ridempc.robots.pinocchio_model import PinocchioRobot, build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.sim.sensors import SensorPacket, VioReading
@@ -117,7 +118,11 @@ class StateEstimator:
         self._platform_sites = tuple(
             np.isin(self.legs.site_foot, [feet.index(f) for f in group]) for group in self.platforms
         )
+        self._platform_rows = tuple(np.flatnonzero(sites) for sites in self._platform_sites)
         self._board_feet_cache: dict[bytes, tuple[tuple[tuple[str, ...], Index, bool], ...]] = {}
+        # Each contact site's place on its platform (platform frame, from the centroid of all
+        # the platform's sites), as last seen with every one of them down; NaN before that.
+        self._footprints = np.full((len(self.legs.site_foot), 3), np.nan)
         self.contact: ContactDetector = build_contact_detector(
             robot, self.pinocchio, self.legs, self.params
         )
@@ -200,6 +205,7 @@ class StateEstimator:
         self.filter = LinearKalmanFilter(x, P)
         self.history.clear()
         self.rejected_feet = 0
+        self._footprints[:] = np.nan
         self._time = packet.time
         self._acceleration = attitude.imu_acceleration
         self._vio_stamp = packet.vio.stamp if packet.vio is not None else None
@@ -279,6 +285,36 @@ class StateEstimator:
             selection = self._board_feet_cache[key] = tuple(chosen)
         return selection
 
+    def _platform(
+        self,
+        group: tuple[str, ...],
+        rows: Index,
+        alone: bool,
+        points: Array,
+        velocities: Array,
+        forward: Array,
+        full: Index,
+    ) -> BoardEstimate:
+        """One platform's estimate from the sites ``rows`` of its sites ``full``: with all of
+        them down it records where each site sits on the platform; with some feet, their
+        recorded places put the origin where all of them would have it. With one foot left
+        the origin stays at it, as before: with the footprint there too, the Segway's
+        velocity-steps fell at 20.1 s instead of 32.7 s, after the first moment (at 19 s,
+        3.5 m/s) that one of Cassie's feet unloaded; why is not yet understood."""
+        footprint = None
+        partial = len(rows) < len(full)
+        if partial and len(group) > 1:
+            known = self._footprints[rows]
+            if np.all(np.isfinite(known)):
+                footprint = known.sum(axis=0) / len(rows)
+        board = estimate_board(
+            group, points, velocities, forward=forward, own_platform=alone, footprint=footprint
+        )
+        if not partial and len(rows) > 1:
+            rotation = matrix_of_rpy(board.roll, board.pitch, board.yaw)
+            self._footprints[rows] = (points - board.position) @ rotation
+        return board
+
     def _output(
         self,
         time: float,
@@ -296,14 +332,18 @@ class StateEstimator:
         q[:3] = base_position
         v[:3] = attitude.rotation.T @ base_velocity
         boards = tuple(
-            estimate_board(
+            self._platform(
                 group,
+                rows,
+                alone,
                 base_position + legs.site_position[rows],
                 base_velocity + legs.site_velocity[rows],
-                forward=attitude.rotation[:, 0],
-                own_platform=alone,
+                attitude.rotation[:, 0],
+                full,
             )
-            for group, rows, alone in self._board_feet(stance)
+            for (group, rows, alone), full in zip(
+                self._board_feet(stance), self._platform_rows, strict=True
+            )
         )
         return EstimatedState(
             time=time,

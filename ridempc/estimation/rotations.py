@@ -7,10 +7,13 @@ Conventions: a quaternion or matrix maps a vector from a body frame to the world
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
 __all__ = [
+    "matrix_of_rpy",
     "matrix_to_quaternion",
     "quaternion_to_matrix",
     "rpy_of_matrix",
@@ -66,3 +69,17 @@ def rpy_of_matrix(rotation: Array) -> tuple[float, float, float]:
     pitch = float(-np.arcsin(min(max(rotation[2, 0], -1.0), 1.0)))  # np.clip: 5 us a scalar
     yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
     return roll, pitch, yaw
+
+
+def matrix_of_rpy(roll: float, pitch: float, yaw: float) -> Array:
+    """:math:`R = R_z(\\psi) R_y(\\theta) R_x(\\phi)` of roll, pitch, yaw [rad]."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )

@@ -208,6 +208,7 @@ class LinearMpc:
             surfaces,
             self.reference.friction,
             self.pair.max_force,
+            self.reference.min_board_share * self.pair.weight / len(index),
         )
         u_lo, u_hi = force_bounds(index, window.contacts, self.pair.input_limits)
         for i, value in self._fixed:

@@ -6,10 +6,11 @@ under it, or the ground's identity), the force on the robot in the surface frame
 
 .. math::
 
-    0 \\le \\phi_{i,z} \\le f_{max}, \\qquad
+    f_{min} \\le \\phi_{i,z} \\le f_{max}, \\qquad
     |\\phi_{i,x}| \\le \\mu\\, \\phi_{i,z}, \\qquad |\\phi_{i,y}| \\le \\mu\\, \\phi_{i,z}
 
-five rows :math:`g^{lo} \\le G u \\le g^{hi}` per contact and step. A swinging contact gets
+with :math:`f_{min}` the library's least force on a contact standing on a board (0 on the
+ground); five rows :math:`g^{lo} \\le G u \\le g^{hi}` per contact and step. A swinging contact gets
 :math:`f_{max} = 0`, so the same rows pin its force to zero: every step has the same rows
 with the same sparsity, whatever the contact schedule, which is what lets the QP keep one
 pattern. As in the paper (Sec. V-B), the rotations are those of the estimated state, held
@@ -53,6 +54,7 @@ def friction_pyramids(
     surfaces: Array,
     friction: float,
     max_force: float,
+    min_force: float = 0.0,
 ) -> tuple[Array, Array, Array]:
     """Friction pyramids of every step (see the module docstring).
 
@@ -64,6 +66,7 @@ def friction_pyramids(
             surface), n_c x 3 x 3; a contact on the ground uses the identity.
         friction: :math:`\\mu` [-].
         max_force: :math:`f_{max}` [N].
+        min_force: :math:`f_{min}` [N] of a contact on a board.
 
     Returns:
         :math:`G` (N x 5 n_c x nu), :math:`g^{lo}`, :math:`g^{hi}` (N x 5 n_c).
@@ -83,7 +86,7 @@ def friction_pyramids(
         board_rows = local @ np.asarray(surfaces[i]).T  # a^T R^T f
         rows_i = np.where(on_board[:, i, None, None], board_rows, local)  # N x 5 x 3
         matrix[:, block, force_index[i]] = rows_i
-        lower[:, block.start] = 0.0
+        lower[:, block.start] = np.where(on_board[:, i], min_force, 0.0)
         upper[:, block.start] = np.where(standing[:, i], max_force, 0.0)
     return matrix, lower, upper
 

@@ -119,6 +119,14 @@ class MotionReference:
         return np.vstack([np.zeros(self.inputs.shape[1]), np.cumsum(self.inputs * self.dt, 0)])
 
     @property
+    def min_board_share(self) -> float:
+        """The library's least normal force on a contact standing on a board, in units of
+        the weight per contact (``options.min_board_force``; 0 when the entry has none)."""
+        options = self.metadata.get("options", {})
+        value = options.get("min_board_force", 0.0) if isinstance(options, dict) else 0.0
+        return float(value) if isinstance(value, int | float) else 0.0
+
+    @property
     def duration(self) -> float:
         """Length of the trajectory [s]."""
         return float(self.times[-1] - self.times[0])

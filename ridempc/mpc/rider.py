@@ -15,10 +15,12 @@ Every 2 ms (500 Hz) the rider
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
    the Z-Y-X angles, the first input's contact forces (summed per foot), the feet in
    contact as the schedule has them over the step, and, for a foot the schedule lifts, a
-   swing target where the plan's joint angles put it (forward kinematics at the estimated
-   base pose); and solves the 500 Hz whole-body QP
-   (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the stance the
-   rider starts from on the board). A foot the schedule puts on the ground (a
+   swing target where the reference puts it, carried by the estimated board
+   (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
+   (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the reference's
+   joint angles where the library has them, the dog's, else the stance the rider starts
+   from on the board: held at the stance, the dog's trunk stayed 3-4 cm above the
+   reference's crouch before a push). A foot the schedule puts on the ground (a
    push-off) stands on the ground for the WBC and the estimator, not on the board;
 4. sends the QP's torques as feedforward with its joint targets to the motor PD, at the
    robot's ``tracking_gain_scale`` of its default gains.
@@ -51,6 +53,7 @@ from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.state_map import StateMap, forward_speed
+from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
@@ -168,12 +171,9 @@ class MpcRider(Controller):
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
-        model = self.pinocchio.model
-        self._plan_joints = [
-            (i, model.joints[model.getJointId(name[2:])].idx_q)
-            for i, name in enumerate(reference.state_names)
-            if name.startswith("q_")
-        ]
+        self.feet = ReferenceFeet(
+            self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
+        )
         self._support: tuple[Contact, ...] | None = None  # per foot, this MPC step
         self._tick = 0
         self._plan: Plan | None = None
@@ -394,12 +394,16 @@ class MpcRider(Controller):
             forces[foot] += f
         assert self._support is not None  # set by the MPC tick, which runs first
         contact = np.array([c is not Contact.SWING for c in self._support])
-        swing = None
-        if not contact.all():  # swing feet go where the plan's joint angles put them
-            q = estimate.q.copy()
-            for i, index in self._plan_joints:
-                q[index] = x[i]
-            swing = self.wbc.model.foot_points(q)
+        swing = swing_velocity = posture = None
+        if self.feet.plans_feet:  # the reference's feet and joint angles
+            t_ref = self.manoeuvre.reference_time(now)
+            state = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
+            posture = self.feet.joint_angles(state, self.wbc.motor_q)
+            if not contact.all():
+                board = estimate.boards[0] if estimate.boards else None
+                swing, swing_velocity = self.feet.targets(self.mpc.reference, t_ref, frame, board)
+        elif not contact.all():  # without planned feet, a lifted foot holds where it is
+            swing = self.wbc.model.foot_points(estimate.q)
         if not contact.any():
             contact[:] = True
         targets = WbcTargets(
@@ -411,6 +415,8 @@ class MpcRider(Controller):
             angular_velocity=rotation @ omega_body,
             site_forces=site_forces if self._sites_match else None,
             swing_position=swing,
+            swing_velocity=swing_velocity,
+            posture=posture,
         )
         out = self.wbc.solve(estimate, targets)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)

@@ -87,6 +87,10 @@ class SkateOptions:
         clearance: Swinging foot's clearance over the deck and the ground [m].
         side_margin: Gap between the deck's edge and the pushing foot on the ground [m].
         crouch: How much lower than the keyframe the trunk is asked to ride [m].
+        min_board_force: Least normal force of a foot standing on the deck, in units of
+            the weight per foot [-]: keeps the centre of mass inside the three-leg support
+            triangle rather than on its diagonal edge (at 0 the optimum carried the front
+            foot opposite the pusher at 6 N, and the MPC rider let it lift off the deck).
         speed_margin: Board speed bound as a multiple of the target [-].
         w_speed: Weight of the board speed error [(m/s)^-2 s^-1].
         w_roll: Weight of the deck roll and roll rate.
@@ -113,6 +117,7 @@ class SkateOptions:
     clearance: float = 0.02
     side_margin: float = 0.02
     crouch: float = 0.06
+    min_board_force: float = 0.4
     speed_margin: float = 1.5
     w_speed: float = 10.0
     w_roll: float = 10.0
@@ -380,7 +385,8 @@ def build_skate_problem(
                 mu * local[2] - local[1],
                 mu * local[2] + local[1],
             )
-            terms.add(cone, 0.0, np.inf)
+            least = o.min_board_force * weight_per_foot if kind is Contact.BOARD else 0.0
+            terms.add(cone, np.array([least, 0.0, 0.0, 0.0, 0.0]), np.inf)
             leg = list(robot.legs[i])
             torque = jac[i][:, leg].T @ (rotation_r.T @ f)
             terms.add(torque, -robot.torque_limit[leg], robot.torque_limit[leg])
