@@ -507,7 +507,7 @@ def test_swing_targets_follow_the_reference_feet_carried_by_the_board(
     the targets move with the estimated board, not with the trunk."""
     from ridempc.estimation.state import BoardEstimate
     from ridempc.mpc.state_map import PlanarFrame
-    from ridempc.mpc.swing import ReferenceFeet
+    from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
     from ridempc.robots import load_robot
     from ridempc.trajopt.skate_pair import skate_models
     from ridempc.wbc.model import WholeBodyModel
@@ -540,8 +540,9 @@ def test_swing_targets_follow_the_reference_feet_carried_by_the_board(
         yaw_rate=0.0,
     )
     frame = PlanarFrame()
-    at_plan, _ = feet.targets(reference, float(middle), frame, None)
-    carried, velocity = feet.targets(reference, float(middle), frame, moved)
+    states = reference.sample(float(middle), 1, VELOCITY_STEP).states
+    at_plan, _ = feet.targets(states, frame, None)
+    carried, velocity = feet.targets(states, frame, moved)
     assert carried - at_plan == pytest.approx(np.tile([0.1, 0.05, 0.0], (4, 1)), abs=1e-9)
     assert np.all(np.isfinite(velocity))
 

@@ -72,7 +72,9 @@ def rpy_of_matrix(rotation: Array) -> tuple[float, float, float]:
 
 
 def matrix_of_rpy(roll: float, pitch: float, yaw: float) -> Array:
-    """:math:`R = R_z(\\psi) R_y(\\theta) R_x(\\phi)` of roll, pitch, yaw [rad]."""
+    """:math:`R = R_z(\\psi) R_y(\\theta) R_x(\\phi)` of roll, pitch, yaw [rad]: NumPy's twin
+    of :func:`ridempc.trajopt.rotations.euler_zyx_matrix`, which would bring CasADi into
+    the estimator."""
     cr, sr = math.cos(roll), math.sin(roll)
     cp, sp = math.cos(pitch), math.sin(pitch)
     cy, sy = math.cos(yaw), math.sin(yaw)

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.mpc.friction import force_bounds, friction_pyramids, pyramid_pattern
+from ridempc.mpc.manoeuvre import YAW_RATE_SUFFIXES
 from ridempc.mpc.pairs import MpcPair, load_mpc_pair, surface_rotations
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MPC_STEP, LinearModel, MpcProblem, build_linear_model, linearize
@@ -137,7 +138,7 @@ class LinearMpc:
         self._fixed = self._fixed_indices(fixed)
         self.settings = replace(self.settings, fixed_inputs=fixed)
 
-    def steers(self, patterns: tuple[str, ...] = ("_psi_dot", "_yaw_rate")) -> bool:
+    def steers(self, patterns: tuple[str, ...] = YAW_RATE_SUFFIXES) -> bool:
         """Whether an input that is not held drives a board's yaw rate directly
         (:math:`\\partial \\dot x / \\partial u \\ne 0` at the reference's start on a state
         named ``*_psi_dot`` or ``*_yaw_rate``): a Hovershoe turns under the feet's yaw

@@ -44,7 +44,15 @@ from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.statics import StaticShift
 from ridempc.scenarios.scenario import Command
 
-__all__ = ["HOLD", "MOVING", "RETARGET_BAND", "Manoeuvre", "ManoeuvreSelector", "StateLayout"]
+__all__ = [
+    "HOLD",
+    "MOVING",
+    "RETARGET_BAND",
+    "YAW_RATE_SUFFIXES",
+    "Manoeuvre",
+    "ManoeuvreSelector",
+    "StateLayout",
+]
 
 Array = NDArray[np.float64]
 MOVING: float = 0.05  # [m/s] a commanded speed below this is rest
@@ -54,6 +62,8 @@ HOLD: str = "hold"
 # 0 -> 1 m/s ramp over 1 s retargeted 30 times, its reference time jumping between 0 and
 # 1.3 s, and fell).
 RETARGET_BAND: float = 0.25
+# Name endings of a board platform's yaw-rate states (the Hovershoes' and the Segway's).
+YAW_RATE_SUFFIXES: tuple[str, ...] = ("_psi_dot", "_yaw_rate")
 
 
 @dataclass(frozen=True)
@@ -243,7 +253,7 @@ class ManoeuvreSelector:
         for name, index in names.items():
             if name.endswith(("_yaw", "_psi")):
                 states[:, index] += turned_k
-            elif name.endswith(("_psi_dot", "_yaw_rate")) or name == "wz":
+            elif name.endswith(YAW_RATE_SUFFIXES) or name == "wz":
                 states[:, index] += step_rates
         return replace(problem, state_reference=states)
 

@@ -53,7 +53,7 @@ from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.state_map import StateMap, forward_speed
-from ridempc.mpc.swing import ReferenceFeet
+from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
@@ -397,11 +397,11 @@ class MpcRider(Controller):
         swing = swing_velocity = posture = None
         if self.feet.plans_feet:  # the reference's feet and joint angles
             t_ref = self.manoeuvre.reference_time(now)
-            state = self.mpc.reference.sample(t_ref, 0, 1.0).states[0]
-            posture = self.feet.joint_angles(state, self.wbc.motor_q)
+            states = self.mpc.reference.sample(t_ref, 1, VELOCITY_STEP).states
+            posture = self.feet.joint_angles(states[0], self.wbc.motor_q)
             if not contact.all():
                 board = estimate.boards[0] if estimate.boards else None
-                swing, swing_velocity = self.feet.targets(self.mpc.reference, t_ref, frame, board)
+                swing, swing_velocity = self.feet.targets(states, frame, board)
         elif not contact.all():  # without planned feet, a lifted foot holds where it is
             swing = self.wbc.model.foot_points(estimate.q)
         if not contact.any():

@@ -39,7 +39,6 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.estimation.state import BoardEstimate
-from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.state_map import PlanarFrame
 from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.wbc.model import WholeBodyModel
@@ -76,6 +75,7 @@ class ReferenceFeet:
             for name, i in names.items()
             if name.startswith("q_")
         ]
+        self._state_of_q = {index: i for i, index in self._joints}
         self._com = [names[f"com_{a}"] for a in "xyz"]
         self._angles = [names[f"{base_prefix}{a}"] for a in ("roll", "pitch", "yaw")]
         self._board_pose = board_pose
@@ -84,8 +84,7 @@ class ReferenceFeet:
     def joint_angles(self, state: Array, motor_q: NDArray[np.int64]) -> Array:
         """The state's joint angles [rad] in the order of ``motor_q`` (configuration
         indices)."""
-        where = {index: i for i, index in self._joints}
-        return np.array([state[where[int(k)]] for k in motor_q])
+        return np.array([state[self._state_of_q[int(k)]] for k in motor_q])
 
     @property
     def plans_feet(self) -> bool:
@@ -105,13 +104,13 @@ class ReferenceFeet:
         return self.model.foot_points(q) - com + state[self._com]
 
     def targets(
-        self, reference: MotionReference, t: float, frame: PlanarFrame, board: BoardEstimate | None
+        self, states: Array, frame: PlanarFrame, board: BoardEstimate | None
     ) -> tuple[Array, Array]:
-        """Swing targets at reference time ``t`` [s]: world positions [m] and velocities
-        [m/s] of every foot, shape (feet, 3) each."""
-        window = reference.sample(t, 1, VELOCITY_STEP)
+        """Swing targets from the reference's states at :math:`t` and
+        :math:`t +` ``VELOCITY_STEP`` (``MotionReference.sample(t, 1, VELOCITY_STEP)``):
+        world positions [m] and velocities [m/s] of every foot, shape (feet, 3) each."""
         ends = []
-        for state in window.states:
+        for state in states[:2]:
             feet = self.points(state)
             if board is not None:
                 x_b, y_b, psi_b = self._board_pose(state)
