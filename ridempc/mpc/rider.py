@@ -13,7 +13,10 @@ Every 2 ms (500 Hz) the rider
    trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
-   the Z-Y-X angles, the first input's contact forces (summed per foot), the feet in
+   the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
+   first-step accelerations :math:`(v_1 - v_0)/\\Delta t` and
+   :math:`(\\omega_1 - \\omega_0)/\\Delta t` fed forward, the first input's contact forces
+   (summed per foot), the feet in
    contact as the schedule has them over the step, and, for a foot the schedule lifts, a
    swing target where the reference puts it, carried by the estimated board
    (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
@@ -21,7 +24,8 @@ Every 2 ms (500 Hz) the rider
    joint angles where the library has them, the dog's, else the stance the rider starts
    from on the board: held at the stance, the dog's trunk stayed 3-4 cm above the
    reference's crouch before a push). A foot the schedule puts on the ground (a
-   push-off) stands on the ground for the WBC and the estimator, not on the board;
+   push-off) stands on the ground for the WBC and the estimator, not on the board; a foot
+   it lifts is left out of the board's estimate even if it touches something;
 4. sends the QP's torques as feedforward with its joint targets to the motor PD, at the
    robot's ``tracking_gain_scale`` of its default gains.
 
@@ -43,6 +47,7 @@ from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
+from ridempc.boards.skateboard.parameters import SkateboardParameters
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -62,6 +67,7 @@ from ridempc.sim.sensors import SensorPacket
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.trajopt.schedule import Contact
+from ridempc.trajopt.skateboard import skateboard_model
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
 from ridempc.wbc.controller import motor_posture
 from ridempc.wbc.platforms import RollingPlatform
@@ -91,7 +97,12 @@ def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
 
 def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
     """The platforms that the rider's push moves, as the WBC sees them: each Hovershoe, the
-    bare shoe with its identified drive (:mod:`ridempc.wbc.platforms`); none otherwise."""
+    bare shoe with its identified drive (:mod:`ridempc.wbc.platforms`); the skateboard's deck,
+    its translating mass with no drive (3.2 kg under a 9 kg dog: taken for ground, the deck
+    feet pushed it 0.24 m/s past its plan as the pusher returned, and push-off-0.7 fell at
+    2.55 s instead of 3.41 s); none otherwise."""
+    if board is not None and isinstance(board.params, SkateboardParameters):
+        return (RollingPlatform(mass=skateboard_model(board).mass, drive=0.0),)
     if board is None or not isinstance(board.params, HovershoesParameters):
         return ()
     shoes = wheeled_board(board)
@@ -164,6 +175,7 @@ class MpcRider(Controller):
             posture=motor_posture(self.pinocchio, robot, robot.stance_qpos(board)),
             platforms=rolling_platforms(loaded),
         )
+        self._feedforward = robot.params.wbc_feedforward
         scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
         self.kp = scale * np.array([m.kp for m in robot.motors])
         self.kd = scale * np.array([m.kd for m in robot.motors])
@@ -317,7 +329,8 @@ class MpcRider(Controller):
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
         """Where each foot is over this MPC step, from the schedule's contacts: on the ground
         if any of its contacts is, in the air if all swing, else on its board. The
-        estimator is told which feet stand on the ground (they say nothing of the board)."""
+        estimator is told which feet stand on the ground and which swing (they say nothing
+        of the board)."""
         feet = self.robot.params.foot_bodies
         support = [Contact.SWING] * len(feet)
         for contact, foot in zip(contacts, self._contact_foot, strict=True):
@@ -327,7 +340,8 @@ class MpcRider(Controller):
                 support[foot] = Contact.BOARD
         self._support = tuple(support)
         ground = [f for f, c in zip(feet, support, strict=True) if c is Contact.GROUND]
-        self.estimator.set_support(ground)
+        swinging = [f for f, c in zip(feet, support, strict=True) if c is Contact.SWING]
+        self.estimator.set_support(ground, swinging)
 
     def _roll_horizon(self, command: Command, now: float, problem: MpcProblem) -> Array:
         """The commanded deck roll at the horizon's nodes [rad]: read ahead from the
@@ -383,6 +397,10 @@ class MpcRider(Controller):
         rotation = euler_zyx_matrix(roll, pitch, yaw + frame.yaw)
         orientation = matrix_to_quaternion(rotation)
         omega_body = np.array([x[n["wx"]], x[n["wy"]], x[n["wz"]]])
+        # The plan's accelerations over its first step, where the robot feeds them forward.
+        step = self._feedforward * (plan.states[1] - plan.states[0]) / self.mpc.settings.dt
+        acceleration = frame.vector_to_world(np.array([step[n[k]] for k in ("vx", "vy", "vz")]))
+        angular_acceleration = rotation @ np.array([step[n[k]] for k in ("wx", "wy", "wz")])
         index = self.mpc.reference.force_index
         feet = len(self.robot.params.foot_bodies)
         forces = np.zeros((feet, 3))
@@ -412,7 +430,9 @@ class MpcRider(Controller):
             contact=contact,
             forces=forces,
             velocity=velocity,
+            acceleration=acceleration,
             angular_velocity=rotation @ omega_body,
+            angular_acceleration=angular_acceleration,
             site_forces=site_forces if self._sites_match else None,
             swing_position=swing,
             swing_velocity=swing_velocity,

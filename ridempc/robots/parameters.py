@@ -89,6 +89,19 @@ class RobotParameters(_Frozen):
         ),
     )
 
+    wbc_feedforward: float = Field(
+        default=0.0,
+        ge=0.0,
+        le=1.0,
+        description=(
+            "Share of the MPC plan's first-step accelerations (centre of mass and base "
+            "rotation, (x_1 - x_0) / dt) that the MPC rider's whole-body QP feeds forward in "
+            "its motion tasks [-]. Without it those tasks, aimed at the plan's next state, "
+            "resist the plan's own forces; with Cassie's noisier estimate the first step "
+            "carries its corrections (up to 40 rad/s^2) and she falls within 2 s."
+        ),
+    )
+
     @model_validator(mode="after")
     def _contact_sites_unique(self) -> RobotParameters:
         if len(set(self.contact_sites)) != len(self.contact_sites):
