@@ -51,6 +51,7 @@ from ridempc.wbc import (
 )
 from ridempc.wbc.contacts import platform_rotation
 from ridempc.wbc.platforms import RollingPlatform
+from ridempc.wbc.settings import DEFAULT_OSQP_SETTINGS
 
 GRAVITY = 9.81
 Springs = Literal["passive", "rigid"]
@@ -359,7 +360,7 @@ def test_persistent_workspace_matches_a_fresh_solve(robot, solver: str) -> None:
     assert wbc.qp.setups == 1  # one workspace, its pattern fixed from the start
 
 
-def test_infeasible_qp_is_retried_cold_then_raises_wbc_failed() -> None:
+def test_infeasible_qp_is_retried_cold_then_by_daqp_then_raises_wbc_failed() -> None:
     robot = load_robot("cyberdog2")
     # 2 kN on every foot cannot be held with 12 N m motors
     wbc = WholeBodyController(robot, WbcSettings(min_normal_force=2000.0, max_normal_force=100))
@@ -372,6 +373,29 @@ def test_infeasible_qp_is_retried_cold_then_raises_wbc_failed() -> None:
     assert isinstance(info.value, RidempcError)
     assert info.value.problem.A.shape[1] == wbc.model.layout.size
     assert wbc.qp.cold_retries == 1 and wbc.qp.setups == 2  # the warm failure retried cold
+    assert info.value.daqp_flag is not None and info.value.daqp_flag < 1  # DAQP: infeasible too
+    assert "DAQP exit flag" in str(info.value) and wbc.qp.fallbacks == 0
+
+
+def test_a_qp_osqp_cannot_solve_goes_to_daqp() -> None:
+    """Where OSQP stops short (here at 3 iterations, warm and cold), DAQP answers the same
+    problem exactly: the tight OSQP optimum, every row within its bounds."""
+    robot = load_robot("cyberdog2")
+    short = {**DEFAULT_OSQP_SETTINGS, "max_iter": 3, "check_termination": 1}
+    wbc = WholeBodyController(robot, WbcSettings(osqp=short))
+    estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
+    q, v = _standing(robot, estimator, np.random.default_rng(5))
+    state, targets = _state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool))
+    out = wbc.solve(state, targets)
+    assert out.status == "solved by daqp" and wbc.qp.fallbacks == 1
+    problem = wbc.last_problem
+    assert problem is not None
+    tight = {**DEFAULT_OSQP_SETTINGS, "eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 100000}
+    reference = WholeBodyController(robot, WbcSettings(osqp=tight)).qp.solve(problem).x
+    x = wbc.last_solution.x
+    assert _cost(problem, x) == pytest.approx(_cost(problem, reference), rel=1e-6, abs=1e-8)
+    ax = problem.A @ x
+    assert np.all(ax <= problem.u + 1e-8) and np.all(ax >= problem.l - 1e-8)
 
 
 def test_targets_are_checked() -> None:

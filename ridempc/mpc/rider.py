@@ -463,6 +463,7 @@ class MpcRider(Controller):
         out["mpc_fallbacks"] = int(qp.failures) if qp is not None else 0
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries
+        out["wbc_daqp_solves"] = self.wbc.qp.fallbacks
         out["safe_hold"] = (
             None
             if self._hold_reason is None
