@@ -12,7 +12,10 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    median and p99 of the update-and-solve time [ms].
 3. **WBC.** The recorded ticks are solved again by a fresh
    :class:`~ridempc.wbc.WholeBodyController`: median and p99 of model update + QP [ms].
-4. **Other solvers.** The same MPC QPs, :math:`\\min \\tfrac12 z^\\top P z` s.t.
+4. **Other solvers.** The same WBC QPs (dense, a tick each) go to DAQP (the WBC's own
+   second solver) and to proxqp through qpsolvers, timed per call from a cold start
+   against OSQP's update-and-solve in its warm workspace, objectives compared with OSQP's.
+   The same MPC QPs, :math:`\\min \\tfrac12 z^\\top P z` s.t.
    :math:`l \\le A z \\le u`, are handed to each other backend available here: the
    qpsolvers backends (``proxqp``, ``daqp``, ... with equality rows :math:`l = u` as
    equalities) and HPIPM through CasADi's ``conic`` interface (in its stage-wise OCP
@@ -59,6 +62,7 @@ class PairBench:
     wbc_failures: int = 0
     ride_status: str = ""
     solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
+    wbc_solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 def _stats(values: Sequence[float]) -> tuple[float, float]:
@@ -346,20 +350,80 @@ def bench_pair(robot: str, board: str, seconds: float = 2.0) -> PairBench:
             pinocchio=rider.pinocchio,
             platforms=rider.wbc.platforms,
         )
-        times = []
+        times, solved = [], []
         for state, targets in wbc_inputs:
             started = time.perf_counter()
             try:
-                wbc.solve(state, targets)
+                output = wbc.solve(state, targets)
             except RidempcError:  # a tick of a ride that was falling: timed, counted
                 out.wbc_failures += 1
+            else:
+                assert wbc.last_problem is not None and wbc.last_solution is not None
+                solved.append((wbc.last_problem, wbc.last_solution.x, 1e-3 * output.solve_ms))
             times.append(time.perf_counter() - started)
         out.wbc_solve_median_ms, out.wbc_solve_p99_ms = _stats(times)
+        out.wbc_solvers = _other_wbc_solvers(solved)
+    return out
+
+
+def _other_wbc_solvers(solved: list) -> dict[str, dict[str, Any]]:
+    """OSQP's WBC solves against DAQP's and proxqp's on the same problems (module
+    docstring); ``solved`` holds (problem, OSQP's solution, OSQP's QP time [s])."""
+    import qpsolvers
+
+    from ridempc.wbc.qp import solve_daqp
+
+    def cost(problem: Any, z: np.ndarray) -> float:
+        return float(0.5 * z @ problem.P @ z + problem.q @ z)
+
+    median, p99 = _stats([seconds for _, _, seconds in solved])
+    out: dict[str, dict[str, Any]] = {
+        "osqp": {
+            "solve_median_ms": median,
+            "solve_p99_ms": p99,
+            "failures": 0,
+            "objective_gap_max": 0.0,
+            "warm_started": True,
+        }
+    }
+    for name in ("daqp", "proxqp"):
+        if name != "daqp" and name not in qpsolvers.available_solvers:
+            continue
+        times, gaps, failures = [], [], 0
+        for problem, x_osqp, _ in solved:
+            best = cost(problem, x_osqp)
+            z: np.ndarray | None
+            if name == "daqp":
+                started = time.perf_counter()
+                z, flag, _, _ = solve_daqp(problem)
+                times.append(time.perf_counter() - started)
+                found = flag >= 1
+            else:
+                qp = _as_qpsolvers(
+                    sp.csc_matrix(problem.P), sp.csc_matrix(problem.A), problem.l, problem.u
+                )
+                qp.q = np.asarray(problem.q, dtype=float)
+                started = time.perf_counter()
+                solution = qpsolvers.solve_problem(qp, solver=name)
+                times.append(time.perf_counter() - started)
+                found = bool(solution.found) and solution.x is not None
+                z = solution.x if found else None
+            if not found or z is None:
+                failures += 1
+            else:
+                gaps.append(abs(cost(problem, z) - best) / max(abs(best), 1e-9))
+        median, p99 = _stats(times)
+        out[name] = {
+            "solve_median_ms": median,
+            "solve_p99_ms": p99,
+            "failures": failures,
+            "objective_gap_max": float(np.max(gaps)) if gaps else None,
+        }
     return out
 
 
 def bench_table(rows: Sequence[PairBench]) -> str:
-    """The results as a Markdown table, then one table of the MPC QP solvers."""
+    """The results as a Markdown table, then one table each of the MPC and WBC QP solvers."""
 
     def f(v: float) -> str:
         return "-" if v != v else f"{v:.2f}"
@@ -376,19 +440,28 @@ def bench_table(rows: Sequence[PairBench]) -> str:
             f"{r.wbc_ticks} ({r.wbc_failures}) | "
             f"{f(r.wbc_solve_median_ms)} / {f(r.wbc_solve_p99_ms)} | {f(r.real_time_factor)} |"
         )
-    lines += ["", "| pair | MPC QP solver | median / p99 [ms] | failures | max objective gap |"]
+    for what, table in (("MPC", "solvers"), ("WBC", "wbc_solvers")):
+        lines += _solver_table(what, [(r.pair, getattr(r, table)) for r in rows])
+    return "\n".join(lines)
+
+
+def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]]]) -> list[str]:
+    def f(v: float) -> str:
+        return "-" if v != v else f"{v:.2f}"
+
+    lines = ["", f"| pair | {what} QP solver | median / p99 [ms] | failures | max objective gap |"]
     lines.append("|---|---|---|---|---|")
-    for r in rows:
-        for name, s in r.solvers.items():
+    for pair, solvers in rows:
+        for name, s in solvers.items():
             if "error" in s:
-                lines.append(f"| {r.pair} | {name} | {s['error']} | - | - |")
+                lines.append(f"| {pair} | {name} | {s['error']} | - | - |")
                 continue
             gap = s["objective_gap_max"]
             lines.append(
-                f"| {r.pair} | {name} | {f(s['solve_median_ms'])} / {f(s['solve_p99_ms'])} | "
+                f"| {pair} | {name} | {f(s['solve_median_ms'])} / {f(s['solve_p99_ms'])} | "
                 f"{s['failures']} | {'-' if gap is None else f'{gap:.1e}'} |"
             )
-    return "\n".join(lines)
+    return lines
 
 
 def bench(

@@ -89,3 +89,8 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     out = bench_pair("cassie", "segway", seconds=0.2)
     assert out.ride_status == "ok" and out.wbc_ticks == 100
     assert out.wbc_failures == 0
+    # the same QPs, to DAQP and proxqp: the same optimum (OSQP polished to its active set)
+    assert {"osqp", "daqp"} <= set(out.wbc_solvers)
+    for name, figures in out.wbc_solvers.items():
+        assert figures["failures"] == 0, name
+        assert figures["objective_gap_max"] < 1e-4, name

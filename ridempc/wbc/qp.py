@@ -53,7 +53,7 @@ from ridempc.wbc.settings import DEFAULT_OSQP_SETTINGS
 from ridempc.wbc.targets import WbcTargets
 from ridempc.wbc.tasks import Task
 
-__all__ = ["QpProblem", "QpSolution", "WbcFailed", "WholeBodyQP"]
+__all__ = ["QpProblem", "QpSolution", "WbcFailed", "WholeBodyQP", "solve_daqp"]
 
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
@@ -113,6 +113,33 @@ class QpSolution:
 def _violation(problem: QpProblem, ax: Array) -> float:
     """Largest distance of :math:`A z` outside :math:`[l, u]`."""
     return float(np.max(np.maximum(ax - problem.u, problem.l - ax), initial=0.0))
+
+
+def solve_daqp(problem: QpProblem) -> tuple[Array, int, int, Array]:
+    """DAQP on the dense problem, rows with :math:`l = u` as equalities.
+
+    Returns:
+        The solution, DAQP's exit flag (1 or more: solved), its iterations and the row
+        multipliers.
+    """
+    equal = problem.l == problem.u
+    sense = np.where(equal, 5, 0).astype(np.int32)  # 5: an equality (active, immutable)
+    upper = np.where(np.isfinite(problem.u), problem.u, DAQP_INFINITY)
+    lower = np.where(np.isfinite(problem.l), problem.l, -DAQP_INFINITY)
+    x, _, flag, info = daqp.solve(
+        np.ascontiguousarray(problem.P, dtype=float),
+        np.array(problem.q, dtype=float),
+        np.ascontiguousarray(problem.A, dtype=float),
+        upper,
+        lower,
+        sense,
+    )
+    return (
+        np.asarray(x, dtype=float),
+        int(flag),
+        int(info["iterations"]),
+        np.asarray(info["lam"], dtype=float),
+    )
 
 
 class WbcFailed(RidempcError, RuntimeError):
@@ -284,32 +311,20 @@ class WholeBodyQP:
         return solution
 
     def _second_solver(self, problem: QpProblem, status: str, start: float) -> QpSolution:
-        """DAQP on the dense problem (module docstring); equality rows are :math:`l = u`.
+        """DAQP on the dense problem (module docstring).
 
         Raises:
             WbcFailed: DAQP finds no finite solution either (with OSQP's ``status``).
         """
-        equal = problem.l == problem.u
-        sense = np.where(equal, 5, 0).astype(np.int32)  # 5: an equality (active, immutable)
-        upper = np.where(np.isfinite(problem.u), problem.u, DAQP_INFINITY)
-        lower = np.where(np.isfinite(problem.l), problem.l, -DAQP_INFINITY)
-        x, _, flag, info = daqp.solve(
-            np.ascontiguousarray(problem.P, dtype=float),
-            np.array(problem.q, dtype=float),
-            np.ascontiguousarray(problem.A, dtype=float),
-            upper,
-            lower,
-            sense,
-        )
-        x = np.asarray(x, dtype=float)
+        x, flag, iterations, duals = solve_daqp(problem)
         if flag < 1 or not np.all(np.isfinite(x)):
-            raise WbcFailed(status, problem, daqp_flag=int(flag))
+            raise WbcFailed(status, problem, daqp_flag=flag)
         self.fallbacks += 1
         solution = QpSolution(
             x=x,
-            y=np.asarray(info["lam"], dtype=float),
+            y=duals,
             status="solved by daqp",
-            iterations=int(info["iterations"]),
+            iterations=iterations,
             polished=True,
             refined=False,
             solve_time=time.perf_counter() - start,
