@@ -106,7 +106,14 @@ def _record(robot_name: str, board_name: str, seconds: float) -> tuple[Any, list
     return result, problems, wbc_inputs, rider, wall
 
 
-def _as_qpsolvers(p: sp.csc_matrix, a: sp.csc_matrix, lower: np.ndarray, upper: np.ndarray) -> Any:
+def _as_qpsolvers(
+    p: sp.csc_matrix,
+    a: sp.csc_matrix,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    q: np.ndarray | None = None,
+) -> Any:
+    """The QP in qpsolvers' form, rows with :math:`l = u` as equalities (``q``: zero)."""
     import qpsolvers
 
     equal = np.isclose(lower, upper)
@@ -115,13 +122,29 @@ def _as_qpsolvers(p: sp.csc_matrix, a: sp.csc_matrix, lower: np.ndarray, upper: 
     rows_lo = ~equal & np.isfinite(lower)
     g = sp.vstack([a[rows_up], -a[rows_lo]]).tocsc()
     h = np.concatenate([upper[rows_up], -lower[rows_lo]])
-    return qpsolvers.Problem(
-        P=p, q=np.zeros(p.shape[0]), G=g, h=h, A=a[equal].tocsc(), b=lower[equal]
-    )
+    linear = np.zeros(p.shape[0]) if q is None else np.asarray(q, dtype=float)
+    return qpsolvers.Problem(P=p, q=linear, G=g, h=h, A=a[equal].tocsc(), b=lower[equal])
 
 
-def _objective(p: sp.csc_matrix, z: np.ndarray) -> float:
-    return float(0.5 * z @ (p @ z))
+def _objective(p: Any, z: np.ndarray, q: np.ndarray | None = None) -> float:
+    """:math:`\tfrac12 z^\top P z + q^\top z` (``q``: zero)."""
+    return float(0.5 * z @ (p @ z) + (0.0 if q is None else q @ z))
+
+
+def _figures(times: Sequence[float], gaps: Sequence[float], failures: int) -> dict[str, Any]:
+    """One solver's row: solve times [s] as median and p99 [ms], failures, and the largest
+    objective gap to OSQP's (relative)."""
+    median, p99 = _stats(times)
+    return {
+        "solve_median_ms": median,
+        "solve_p99_ms": p99,
+        "failures": failures,
+        "objective_gap_max": float(np.max(gaps)) if gaps else None,
+    }
+
+
+def _gap(value: float, best: float) -> float:
+    return abs(value - best) / max(abs(best), 1e-9)
 
 
 def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
@@ -158,14 +181,8 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
                 if z is None:
                     failures += 1
                 else:
-                    gaps.append(abs(_objective(p, z) - best) / max(abs(best), 1e-9))
-            median, p99 = _stats(times)
-            out[name] = {
-                "solve_median_ms": median,
-                "solve_p99_ms": p99,
-                "failures": failures,
-                "objective_gap_max": float(np.max(gaps)) if gaps else None,
-            }
+                    gaps.append(_gap(_objective(p, z), best))
+            out[name] = _figures(times, gaps, failures)
         except Exception as exc:  # a backend's own error: reported, not fatal
             message = " ".join(f"{type(exc).__name__}: {exc}".split())
             out[name] = {"error": message[:160]}
@@ -373,60 +390,46 @@ def _other_wbc_solvers(solved: list) -> dict[str, dict[str, Any]]:
 
     from ridempc.wbc.qp import solve_daqp
 
-    def cost(problem: Any, z: np.ndarray) -> float:
-        return float(0.5 * z @ problem.P @ z + problem.q @ z)
-
-    median, p99 = _stats([seconds for _, _, seconds in solved])
-    out: dict[str, dict[str, Any]] = {
-        "osqp": {
-            "solve_median_ms": median,
-            "solve_p99_ms": p99,
-            "failures": 0,
-            "objective_gap_max": 0.0,
-            "warm_started": True,
-        }
-    }
+    out = {"osqp": {**_figures([t for _, _, t in solved], [0.0], 0), "warm_started": True}}
     for name in ("daqp", "proxqp"):
         if name != "daqp" and name not in qpsolvers.available_solvers:
             continue
         times, gaps, failures = [], [], 0
         for problem, x_osqp, _ in solved:
-            best = cost(problem, x_osqp)
             z: np.ndarray | None
             if name == "daqp":
                 started = time.perf_counter()
                 z, flag, _, _ = solve_daqp(problem)
                 times.append(time.perf_counter() - started)
-                found = flag >= 1
+                z = z if flag >= 1 else None
             else:
                 qp = _as_qpsolvers(
-                    sp.csc_matrix(problem.P), sp.csc_matrix(problem.A), problem.l, problem.u
+                    sp.csc_matrix(problem.P),
+                    sp.csc_matrix(problem.A),
+                    problem.l,
+                    problem.u,
+                    problem.q,
                 )
-                qp.q = np.asarray(problem.q, dtype=float)
                 started = time.perf_counter()
                 solution = qpsolvers.solve_problem(qp, solver=name)
                 times.append(time.perf_counter() - started)
-                found = bool(solution.found) and solution.x is not None
-                z = solution.x if found else None
-            if not found or z is None:
+                z = solution.x if solution.found else None
+            if z is None:
                 failures += 1
             else:
-                gaps.append(abs(cost(problem, z) - best) / max(abs(best), 1e-9))
-        median, p99 = _stats(times)
-        out[name] = {
-            "solve_median_ms": median,
-            "solve_p99_ms": p99,
-            "failures": failures,
-            "objective_gap_max": float(np.max(gaps)) if gaps else None,
-        }
+                best = _objective(problem.P, x_osqp, problem.q)
+                gaps.append(_gap(_objective(problem.P, z, problem.q), best))
+        out[name] = _figures(times, gaps, failures)
     return out
+
+
+def _ms(v: float) -> str:
+    """A figure for the tables, '-' when NaN."""
+    return "-" if v != v else f"{v:.2f}"
 
 
 def bench_table(rows: Sequence[PairBench]) -> str:
     """The results as a Markdown table, then one table each of the MPC and WBC QP solvers."""
-
-    def f(v: float) -> str:
-        return "-" if v != v else f"{v:.2f}"
 
     lines = [
         "| pair | ride | MPC problems | MPC median / p99 [ms] | WBC ticks (failed) | "
@@ -436,9 +439,10 @@ def bench_table(rows: Sequence[PairBench]) -> str:
     for r in rows:
         lines.append(
             f"| {r.pair} | {r.ride_status} ({r.simulated_s:.2f} s) | {r.mpc_problems} | "
-            f"{f(r.mpc_solve_median_ms)} / {f(r.mpc_solve_p99_ms)} | "
+            f"{_ms(r.mpc_solve_median_ms)} / {_ms(r.mpc_solve_p99_ms)} | "
             f"{r.wbc_ticks} ({r.wbc_failures}) | "
-            f"{f(r.wbc_solve_median_ms)} / {f(r.wbc_solve_p99_ms)} | {f(r.real_time_factor)} |"
+            f"{_ms(r.wbc_solve_median_ms)} / {_ms(r.wbc_solve_p99_ms)} | "
+            f"{_ms(r.real_time_factor)} |"
         )
     for what, table in (("MPC", "solvers"), ("WBC", "wbc_solvers")):
         lines += _solver_table(what, [(r.pair, getattr(r, table)) for r in rows])
@@ -446,8 +450,6 @@ def bench_table(rows: Sequence[PairBench]) -> str:
 
 
 def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]]]) -> list[str]:
-    def f(v: float) -> str:
-        return "-" if v != v else f"{v:.2f}"
 
     lines = ["", f"| pair | {what} QP solver | median / p99 [ms] | failures | max objective gap |"]
     lines.append("|---|---|---|---|---|")
@@ -458,7 +460,7 @@ def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]
                 continue
             gap = s["objective_gap_max"]
             lines.append(
-                f"| {pair} | {name} | {f(s['solve_median_ms'])} / {f(s['solve_p99_ms'])} | "
+                f"| {pair} | {name} | {_ms(s['solve_median_ms'])} / {_ms(s['solve_p99_ms'])} | "
                 f"{s['failures']} | {'-' if gap is None else f'{gap:.1e}'} |"
             )
     return lines

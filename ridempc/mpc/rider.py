@@ -398,9 +398,11 @@ class MpcRider(Controller):
         orientation = matrix_to_quaternion(rotation)
         omega_body = np.array([x[n["wx"]], x[n["wy"]], x[n["wz"]]])
         # The plan's accelerations over its first step, where the robot feeds them forward.
-        step = self._feedforward * (plan.states[1] - plan.states[0]) / self.mpc.settings.dt
-        acceleration = frame.vector_to_world(np.array([step[n[k]] for k in ("vx", "vy", "vz")]))
-        angular_acceleration = rotation @ np.array([step[n[k]] for k in ("wx", "wy", "wz")])
+        acceleration = angular_acceleration = np.zeros(3)
+        if self._feedforward:
+            step = self._feedforward * (plan.states[1] - plan.states[0]) / self.mpc.settings.dt
+            acceleration = frame.vector_to_world(np.array([step[n[k]] for k in ("vx", "vy", "vz")]))
+            angular_acceleration = rotation @ np.array([step[n[k]] for k in ("wx", "wy", "wz")])
         index = self.mpc.reference.force_index
         feet = len(self.robot.params.foot_bodies)
         forces = np.zeros((feet, 3))
