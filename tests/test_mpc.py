@@ -317,6 +317,12 @@ def test_reference_schedule_and_steady_riding(skate_mpc: LinearMpc) -> None:
         window.states[:, names.index("com_z")], reference.states[-1, 2], atol=1e-3
     )
     np.testing.assert_allclose(window.inputs, np.tile(reference.inputs[-1], (3, 1)))
+    # The 500 Hz tick's states alone are the window's, before, during and after the entry.
+    for t in (-1.0, 0.4 * reference.duration, reference.duration + 1.0):
+        times = t + MPC_STEP * np.arange(4)
+        np.testing.assert_array_equal(
+            reference.states_at(times), reference.sample(t, 3, MPC_STEP).states
+        )
 
 
 def test_reference_blends_neighbouring_entries() -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -10,7 +11,9 @@ import pytest
 
 from ridempc.boards import load_board
 from ridempc.cli import main
+from ridempc.estimation import EstimatedState
 from ridempc.mpc.rider import WBC_GRACE_TICKS, MpcRider
+from ridempc.mpc.state_map import HEADING_FILTER_S
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -258,7 +261,41 @@ def test_the_frame_follows_the_board_sideways_only(dog) -> None:
 
 def test_turns_are_laid_over_the_boards_the_rider_can_turn() -> None:
     """A Hovershoe turns under the feet's yaw torque; the Segway only by its knee bar, which
-    the rider does not push (pinned), so a yaw-rate command is not laid over its reference."""
+    the rider does not push (pinned), so a yaw-rate command is not laid over its reference,
+    and its library frame turns with the board's direction of travel instead."""
     cassie = load_robot("cassie")
-    assert MpcRider(cassie, "hovershoes").steers
-    assert not MpcRider(cassie, "segway").steers
+    shoes, segway = MpcRider(cassie, "hovershoes"), MpcRider(cassie, "segway")
+    assert shoes.steers and not shoes._follows_heading
+    assert not segway.steers and segway._follows_heading
+
+
+def test_the_frame_turns_with_the_direction_of_travel(dog) -> None:
+    """With ``heading``, the frame turns about the board until the board's direction of
+    travel (0.1 rad off, whatever its estimated yaw) is the reference's heading, low-passed
+    over ``HEADING_FILTER_S``, and the board stays on the reference's line; slower than
+    ``HEADING_SPEED`` it does not turn."""
+    _, rider = _ride(dog, 0.1)
+    estimate = rider.estimator.state
+    assert estimate is not None and estimate.boards
+    state_map = rider.map
+    board = estimate.boards[0]
+    place = state_map.frame.point_to_library(board.position)
+    pose = (float(place[0]), float(place[1]), 0.0)
+    start = state_map.frame.yaw
+
+    def moving(speed: float, time: float) -> EstimatedState:
+        velocity = speed * np.array([np.cos(start + 0.1), np.sin(start + 0.1), 0.0])
+        moved = replace(board, velocity=velocity)
+        return replace(estimate, boards=(moved, *estimate.boards[1:]), time=time)
+
+    t0 = estimate.time
+    for k in range(1, 31):  # 1 s at 30 Hz, slower than HEADING_SPEED
+        state_map.follow_sideways(moving(0.3, t0 + k / 30.0), pose, heading=True)
+    assert state_map.frame.yaw == pytest.approx(start)
+    state_map.follow_sideways(moving(3.0, t0 + 1.0 + HEADING_FILTER_S / 3.0), pose, heading=True)
+    assert state_map.frame.yaw - start == pytest.approx(0.1 / 3.0)  # a third of the way
+    for k in range(1, 61):
+        state_map.follow_sideways(moving(3.0, t0 + 2.0 + k / 30.0), pose, heading=True)
+    assert state_map.frame.yaw - start == pytest.approx(0.1, abs=1e-6)
+    on_line = state_map.frame.point_to_library(board.position)
+    assert on_line[1] == pytest.approx(pose[1], abs=1e-9)

@@ -146,8 +146,7 @@ class MotionReference:
         """
         times = np.arange(horizon + 1, dtype=np.float64) * dt + t0
         end = self.times[-1]
-        states = _interp_rows(times, self.times, self.states)
-        states += np.maximum(times - end, 0.0)[:, None] * self.steady_rates
+        states = self.states_at(times)
         # Inputs averaged over each step: differences of their running integral.
         step = self.dt
         clipped = np.maximum(times, self.times[0])
@@ -168,6 +167,15 @@ class MotionReference:
                     inputs[k, self.force_index[i]] = 0.0
         parameters = self.parameters[interval]
         return ReferenceWindow(times, states, inputs, parameters, contacts)
+
+    def states_at(self, times: Array) -> Array:
+        """The states alone at ``times`` [s] since the start, rows as :meth:`sample`'s
+        (held before the start, ridden on steadily after the end): what the 500 Hz tick
+        reads, without the inputs, contacts and parameters of a whole window."""
+        times = np.asarray(times, dtype=np.float64)
+        states = _interp_rows(times, self.times, self.states)
+        states += np.maximum(times - self.times[-1], 0.0)[:, None] * self.steady_rates
+        return states
 
 
 def _interp_rows(t: Array, grid: Array, table: Array) -> Array:

@@ -53,7 +53,7 @@ from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.manoeuvre import Manoeuvre, ManoeuvreSelector, StateLayout
+from ridempc.mpc.manoeuvre import YAW_RATE_SUFFIXES, Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
@@ -152,6 +152,10 @@ class MpcRider(Controller):
         # board (not the Segway with its knee bar pinned: it rode yaw-steps straight, and
         # with the turn laid over it fell at 7.7 s).
         self.steers = self.mpc.steers()
+        # A board with a yaw rate that the rider cannot drive (the Segway's): the library
+        # frame turns with its heading (StateMap.follow_sideways).
+        yaw_rates = any(n.endswith(YAW_RATE_SUFFIXES) for n in self.mpc.reference.state_names)
+        self._follows_heading = yaw_rates and not self.steers
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_names(reference.state_names)
@@ -229,8 +233,8 @@ class MpcRider(Controller):
 
     def _anchor(self, estimate: EstimatedState, now: float) -> None:
         self.manoeuvre = self.manoeuvre.started(now)
-        window = self.mpc.reference.sample(self.manoeuvre.reference_time(now), 0, 1.0)
-        pose = self.layout.board_pose(window.states[0])
+        state = self.mpc.reference.states_at(np.array([self.manoeuvre.reference_time(now)]))[0]
+        pose = self.layout.board_pose(state)
         self.map.anchor(estimate, pose)
 
     def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
@@ -322,9 +326,11 @@ class MpcRider(Controller):
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])
-        x, y, heading = self.layout.board_pose(self.mpc.reference.sample(t_ref, 0, 1.0).states[0])
+        x, y, heading = self.layout.board_pose(self.mpc.reference.states_at(np.array([t_ref]))[0])
         turning = bool(np.any(turn)) or self._turned != 0.0
-        self.map.follow_sideways(estimate, (x, y, heading + self._turned), along=turning)
+        self.map.follow_sideways(
+            estimate, (x, y, heading + self._turned), along=turning, heading=self._follows_heading
+        )
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
         """Where each foot is over this MPC step, from the schedule's contacts: on the ground
@@ -417,7 +423,7 @@ class MpcRider(Controller):
         swing = swing_velocity = posture = None
         if self.feet.plans_feet:  # the reference's feet and joint angles
             t_ref = self.manoeuvre.reference_time(now)
-            states = self.mpc.reference.sample(t_ref, 1, VELOCITY_STEP).states
+            states = self.mpc.reference.states_at(np.array([t_ref, t_ref + VELOCITY_STEP]))
             posture = self.feet.joint_angles(states[0], self.wbc.motor_q)
             if not contact.all():
                 board = estimate.boards[0] if estimate.boards else None

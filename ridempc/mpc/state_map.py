@@ -43,10 +43,19 @@ from ridempc.estimation.rotations import rpy_of_matrix
 from ridempc.estimation.state import BoardEstimate
 from ridempc.robots.pinocchio_model import PinocchioRobot
 
-__all__ = ["RATE_FILTER_HZ", "PlanarFrame", "StateMap", "forward_speed"]
+__all__ = [
+    "HEADING_FILTER_S",
+    "HEADING_SPEED",
+    "RATE_FILTER_HZ",
+    "PlanarFrame",
+    "StateMap",
+    "forward_speed",
+]
 
 Array = NDArray[np.float64]
 RATE_FILTER_HZ: float = 15.0  # [Hz] on the differentiated platform angles
+HEADING_SPEED: float = 0.5  # [m/s] below this a board's direction of travel is not its heading
+HEADING_FILTER_S: float = 0.3  # [s] time constant of the followed heading
 
 
 def forward_speed(board: BoardEstimate) -> float:
@@ -132,6 +141,7 @@ class StateMap:
         self.prefixes = tuple(platform_prefixes)
         self.frame = PlanarFrame()
         self._rates: dict[str, _AngleRate] = {}
+        self._heading_time = 0.0
         self._fill = [self._filler(name) for name in self.names]
 
     def _filler(self, name: str) -> tuple[str, int | str]:
@@ -155,6 +165,7 @@ class StateMap:
     def reset(self) -> None:
         self.frame = PlanarFrame()
         self._rates = {}
+        self._heading_time = 0.0
 
     def _board_value(self, key: str, boards: tuple[BoardEstimate, ...], time: float) -> float:
         index, field = key.split(":", 1)
@@ -238,6 +249,7 @@ class StateMap:
         estimate: EstimatedState,
         board_pose: tuple[float, float, float],
         along: bool = False,
+        heading: bool = False,
     ) -> float:
         """Shift the frame across the reference's heading so that platform 0's estimate
         lies on the reference's line: its cross-track offset
@@ -252,7 +264,18 @@ class StateMap:
         rider's centre of mass on that line, leaned Cassie off her platform (velocity
         steps fell at 26.4 s). Offsets between the rider and the board are unchanged.
         With ``along`` the offset along the line is taken out too (while turning: the
-        reference's straight line is not the arc the board rides).
+        reference's straight line is not the arc the board rides). With ``heading`` the
+        frame first turns about the platform, keeping its place, so that the platform's
+        direction of travel is the reference's heading: for a wheeled board whose heading
+        the rider cannot steer (the Segway with its knee bar free), which a yaw-rate loop
+        holds but nothing brings back. Its heading wandered by 0.08 rad in 1 s of braking
+        from 4 m/s; the MPC held Cassie's pelvis and velocity on the reference's heading,
+        and she stepped 0.24 m sideways off the board (velocity steps fell at 32.7 s). The
+        direction of travel, :math:`\\operatorname{atan2}(\\dot c_y, \\dot c_x)` of the
+        feet's velocity (wheels do not slide sideways), low-passed over
+        ``HEADING_FILTER_S``, is the heading the feet can tell: the platform estimate's own
+        yaw is the rider's (two feet side by side), and following it let the rider's yaw
+        run off. Below ``HEADING_SPEED`` the frame does not turn.
 
         Returns:
             The shift :math:`e` [m] (0 without a board estimate).
@@ -260,7 +283,21 @@ class StateMap:
         if not estimate.boards:
             return 0.0
         x_ref, y_ref, yaw_ref = board_pose
-        p_lib = self.frame.point_to_library(estimate.boards[0].position)
+        board = estimate.boards[0]
+        speed = math.hypot(float(board.velocity[0]), float(board.velocity[1]))
+        if heading and speed > HEADING_SPEED:
+            travel = math.atan2(float(board.velocity[1]), float(board.velocity[0]))
+            if forward_speed(board) < 0.0:
+                travel = _wrap(travel + math.pi)
+            wanted = _wrap(travel - yaw_ref)
+            share = min(1.0, (estimate.time - self._heading_time) / HEADING_FILTER_S)
+            kept = self.frame.point_to_library(board.position)
+            turned = PlanarFrame(self.frame.yaw + share * _wrap(wanted - self.frame.yaw))
+            place = turned.vector_to_world(kept)
+            offset = (float(board.position[0] - place[0]), float(board.position[1] - place[1]))
+            self.frame = PlanarFrame(turned.yaw, offset)
+        self._heading_time = estimate.time
+        p_lib = self.frame.point_to_library(board.position)
         normal = np.array([-math.sin(yaw_ref), math.cos(yaw_ref), 0.0])
         gap = p_lib[:2] - np.array([x_ref, y_ref])
         error = float(normal[:2] @ gap)

@@ -107,7 +107,7 @@ class ReferenceFeet:
         self, states: Array, frame: PlanarFrame, board: BoardEstimate | None
     ) -> tuple[Array, Array]:
         """Swing targets from the reference's states at :math:`t` and
-        :math:`t +` ``VELOCITY_STEP`` (``MotionReference.sample(t, 1, VELOCITY_STEP)``):
+        :math:`t +` ``VELOCITY_STEP`` (``MotionReference.states_at``):
         world positions [m] and velocities [m/s] of every foot, shape (feet, 3) each."""
         ends = []
         for state in states[:2]:
