@@ -6,8 +6,9 @@ Every 2 ms (500 Hz) the rider
    board from its own feet);
 2. every 15th tick (30 Hz), maps the estimate into the library frame
    (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto the
-   reference's line: speeds and turn rates are commanded, not a path) and solves the
-   linear MPC
+   reference's line: speeds and turn rates are commanded, not a path; on a board the
+   rider cannot steer, the Segway, it also turns with the board's direction of travel)
+   and solves the linear MPC
    (:class:`~ridempc.mpc.controller.LinearMpc`) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
