@@ -127,7 +127,7 @@ def _as_qpsolvers(
 
 
 def _objective(p: Any, z: np.ndarray, q: np.ndarray | None = None) -> float:
-    """:math:`\tfrac12 z^\top P z + q^\top z` (``q``: zero)."""
+    """:math:`\\tfrac12 z^\\top P z + q^\\top z` (``q``: zero)."""
     return float(0.5 * z @ (p @ z) + (0.0 if q is None else q @ z))
 
 
@@ -450,7 +450,7 @@ def bench_table(rows: Sequence[PairBench]) -> str:
 
 
 def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]]]) -> list[str]:
-
+    """One solver table: per pair and solver, median / p99 [ms], failures, largest gap."""
     lines = ["", f"| pair | {what} QP solver | median / p99 [ms] | failures | max objective gap |"]
     lines.append("|---|---|---|---|---|")
     for pair, solvers in rows:

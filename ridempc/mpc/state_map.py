@@ -84,6 +84,21 @@ class PlanarFrame:
         c, s = math.cos(self.yaw), math.sin(sign * self.yaw)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
+    @classmethod
+    def through(
+        cls, yaw: float, library: Sequence[float] | Array, world: Sequence[float] | Array
+    ) -> PlanarFrame:
+        """The frame turned by ``yaw`` [rad] that puts the library point ``library`` on the
+        world point ``world`` [m] (their x and y)."""
+        c, s = math.cos(yaw), math.sin(yaw)
+        return cls(
+            yaw,
+            (
+                float(world[0] - (c * library[0] - s * library[1])),
+                float(world[1] - (s * library[0] + c * library[1])),
+            ),
+        )
+
     def point_to_library(self, p: Array) -> Array:
         shifted = np.asarray(p, dtype=float) - np.array([*self.offset, 0.0])
         return self._rotation(-1.0) @ shifted
@@ -236,13 +251,7 @@ class StateMap:
         else:
             yaw_world, position = board.yaw, board.position
         x_ref, y_ref, yaw_ref = board_pose
-        dyaw = _wrap(yaw_world - yaw_ref)
-        c, s = math.cos(dyaw), math.sin(dyaw)
-        offset = (
-            float(position[0] - (c * x_ref - s * y_ref)),
-            float(position[1] - (s * x_ref + c * y_ref)),
-        )
-        self.frame = PlanarFrame(dyaw, offset)
+        self.frame = PlanarFrame.through(_wrap(yaw_world - yaw_ref), (x_ref, y_ref), position)
 
     def follow_sideways(
         self,
@@ -284,18 +293,16 @@ class StateMap:
             return 0.0
         x_ref, y_ref, yaw_ref = board_pose
         board = estimate.boards[0]
-        speed = math.hypot(float(board.velocity[0]), float(board.velocity[1]))
-        if heading and speed > HEADING_SPEED:
-            travel = math.atan2(float(board.velocity[1]), float(board.velocity[0]))
+        vx, vy = float(board.velocity[0]), float(board.velocity[1])
+        if heading and math.hypot(vx, vy) > HEADING_SPEED:
+            travel = math.atan2(vy, vx)
             if forward_speed(board) < 0.0:
                 travel = _wrap(travel + math.pi)
             wanted = _wrap(travel - yaw_ref)
             share = min(1.0, (estimate.time - self._heading_time) / HEADING_FILTER_S)
+            yaw = self.frame.yaw + share * _wrap(wanted - self.frame.yaw)
             kept = self.frame.point_to_library(board.position)
-            turned = PlanarFrame(self.frame.yaw + share * _wrap(wanted - self.frame.yaw))
-            place = turned.vector_to_world(kept)
-            offset = (float(board.position[0] - place[0]), float(board.position[1] - place[1]))
-            self.frame = PlanarFrame(turned.yaw, offset)
+            self.frame = PlanarFrame.through(yaw, kept, board.position)
         self._heading_time = estimate.time
         p_lib = self.frame.point_to_library(board.position)
         normal = np.array([-math.sin(yaw_ref), math.cos(yaw_ref), 0.0])

@@ -110,12 +110,14 @@ class ReferenceFeet:
         :math:`t +` ``VELOCITY_STEP`` (``MotionReference.states_at``):
         world positions [m] and velocities [m/s] of every foot, shape (feet, 3) each."""
         ends = []
+        if board is not None:  # the estimated board in the library frame, for both states
+            place = frame.point_to_library(board.position)
+            heading = board.yaw - frame.yaw
         for state in states[:2]:
             feet = self.points(state)
             if board is not None:
                 x_b, y_b, psi_b = self._board_pose(state)
-                place = frame.point_to_library(board.position)
-                turn = (board.yaw - frame.yaw) - psi_b
+                turn = heading - psi_b
                 c, s = math.cos(turn), math.sin(turn)
                 dx, dy = feet[:, 0] - x_b, feet[:, 1] - y_b
                 feet[:, 0] = place[0] + c * dx - s * dy
