@@ -7,9 +7,11 @@ under it, or the ground's identity), the force on the robot in the surface frame
 .. math::
 
     f_{min} \\le \\phi_{i,z} \\le f_{max}, \\qquad
-    |\\phi_{i,x}| \\le \\mu\\, \\phi_{i,z}, \\qquad |\\phi_{i,y}| \\le \\mu\\, \\phi_{i,z}
+    |\\phi_{i,x}| \\le s\\, \\phi_{i,z}, \\qquad |\\phi_{i,y}| \\le s\\, \\phi_{i,z}
 
-with :math:`f_{min}` the library's least force on a contact standing on a board (0 on the
+with :math:`s = \\mu/\\sqrt2` the slope of the Coulomb cone's inner pyramid
+(:mod:`ridempc.friction`: the outer one, :math:`s = \\mu`, let the dog's pushing foot slide)
+and :math:`f_{min}` the library's least force on a contact standing on a board (0 on the
 ground); five rows :math:`g^{lo} \\le G u \\le g^{hi}` per contact and step. A swinging contact gets
 :math:`f_{max} = 0`, so the same rows pin its force to zero: every step has the same rows
 with the same sparsity, whatever the contact schedule, which is what lets the QP keep one
@@ -24,6 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.friction import pyramid_slope
 from ridempc.trajopt.schedule import Contact
 
 __all__ = ["ROWS_PER_CONTACT", "force_bounds", "friction_pyramids", "pyramid_pattern"]
@@ -31,8 +34,8 @@ __all__ = ["ROWS_PER_CONTACT", "force_bounds", "friction_pyramids", "pyramid_pat
 Array = NDArray[np.float64]
 ROWS_PER_CONTACT = 5
 
-# Rows of one pyramid on the local force (phi_x, phi_y, phi_z), with mu = 1 for the shape;
-# the mu column multiplies phi_z.
+# Rows of one pyramid on the local force (phi_x, phi_y, phi_z), with s = 1 for the shape;
+# the s column multiplies phi_z.
 _TANGENT = np.array(
     [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]]
 )
@@ -64,7 +67,7 @@ def friction_pyramids(
         schedule: Per step, per contact, where it is (board, ground or swing), N x n_c.
         surfaces: Per contact, the rotation of the board surface under it (world from
             surface), n_c x 3 x 3; a contact on the ground uses the identity.
-        friction: :math:`\\mu` [-].
+        friction: Coulomb coefficient :math:`\\mu` [-].
         max_force: :math:`f_{max}` [N].
         min_force: :math:`f_{min}` [N] of a contact on a board.
 
@@ -77,7 +80,7 @@ def friction_pyramids(
     lower = np.full((n, rows), -np.inf)
     upper = np.zeros((n, rows))
     local = _TANGENT.copy()
-    local[:, 2] += friction * _NORMAL  # rows on phi: (phi_z, phi_x - mu phi_z, ...)
+    local[:, 2] += pyramid_slope(friction) * _NORMAL  # rows on phi: (phi_z, phi_x - s phi_z, ...)
     kinds = np.array([[kind.value for kind in step] for step in schedule]).reshape(n, nc)
     on_board = kinds == Contact.BOARD.value
     standing = kinds != Contact.SWING.value

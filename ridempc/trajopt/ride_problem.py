@@ -12,7 +12,8 @@ torques). Constraints:
 - collocation of the dynamics (:mod:`.problem`);
 - legs: each hip-to-foot distance within the rider's band, the feet on their own sides of
   the pelvis, the pelvis heading within 0.35 rad of the platforms';
-- contacts: friction pyramids on the platform normals (:math:`\\mu`), a normal force of at
+- contacts: friction pyramids on the platform normals (the inner pyramid of :math:`\\mu`,
+  :mod:`ridempc.friction`), a normal force of at
   most the rider's weight, and on the Hovershoes a yaw torque per shoe within the tyres'
   grip (4 N m);
 - board: platform pitch within ``pitch_limit``, speed within the board's limit, the Segway's
@@ -43,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.friction import pyramid_slope
 from ridempc.trajopt.platforms import WheeledBoard, platform_pushes, platform_torques
 from ridempc.trajopt.problem import NodeSpec, NodeTerms, TrajectoryProblem, assemble_problem
 from ridempc.trajopt.rider import RiderModel
@@ -272,7 +274,7 @@ def build_ride_problem(
         for k in range(nc):
             plate, _ = board.pose(xb, platform_of[k])
             local = plate.T @ forces[k]
-            mu = o.friction
+            mu = pyramid_slope(o.friction)
             terms.add(
                 ca.vertcat(
                     local[2],

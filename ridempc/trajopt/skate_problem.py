@@ -14,8 +14,9 @@ contact schedule's grid (:mod:`.schedule`), Hermite-Simpson within each interval
   a foot on the deck stays at its place in the deck frame,
   :math:`R_B^\\top (p_i - o_B) = {}^C r_{B_i}` (so its velocity is the deck's, eq. 15), and
   the pushing foot on the ground stays where it landed, on the ground, beside the deck;
-- friction pyramids (:math:`|f_t| \\le \\mu f_n` along two tangents, :math:`f_n \\ge 0`) on
-  the surface's normal, no force on a swinging foot;
+- friction pyramids (:math:`|f_t| \\le (\\mu/\\sqrt2) f_n` along two tangents, the Coulomb
+  cone's inner pyramid, :mod:`ridempc.friction`; :math:`f_n \\ge 0`) on the surface's
+  normal, no force on a swinging foot;
 - joint torques of the stance legs, :math:`\\tau = -J_i(q)^\\top R_R^\\top f_i` (the massless
   leg's statics), within the motor limits (12 N m on CyberDog2); joint angles and speeds
   within the MJCF's and ``robot.toml``'s limits; board roll within its bottom-out angle;
@@ -40,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.friction import pyramid_slope
 from ridempc.trajopt.problem import (
     NodeSpec,
     NodeTerms,
@@ -377,7 +379,7 @@ def build_skate_problem(
                 continue
             f = u[3 * i : 3 * i + 3]
             local = (rotation_b if kind is Contact.BOARD else ca.DM.eye(3)).T @ f
-            mu = o.friction
+            mu = pyramid_slope(o.friction)
             cone = ca.vertcat(
                 local[2],
                 mu * local[2] - local[0],

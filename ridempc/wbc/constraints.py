@@ -17,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.friction import pyramid_slope
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
@@ -236,21 +237,22 @@ class ContactAccelerationConstraint(Constraint):
 
 
 class FrictionPyramidConstraint(Constraint):
-    """Unilateral contact inside a friction pyramid, in each site's support frame:
+    """Unilateral contact inside the friction cone's inner pyramid (slope
+    :math:`s = \\mu/\\sqrt2`, :mod:`ridempc.friction`), in each site's support frame:
 
-    .. math:: |t_k^\\top f_s| \\le \\mu\\, n^\\top f_s \\ (k = 1, 2), \\qquad
+    .. math:: |t_k^\\top f_s| \\le s\\, n^\\top f_s \\ (k = 1, 2), \\qquad
               f_{min} \\le n^\\top f_s \\le f_{max}
 
     [N] for a site in contact (the pyramid implies :math:`n^\\top f_s \\ge 0`, so with
     :math:`f_{min} = 0` the normal row only bounds from above). A site in the air gets no
     force, :math:`f_s = 0`, as three equalities on the same rows,
-    :math:`(t_1 - \\mu n)^\\top f_s = (t_2 - \\mu n)^\\top f_s = n^\\top f_s = 0`, the other two
+    :math:`(t_1 - s n)^\\top f_s = (t_2 - s n)^\\top f_s = n^\\top f_s = 0`, the other two
     left free: pinning all five at zero would make a degenerate active set (five rows on
     three unknowns), on which OSQP's polishing fails.
 
     Args:
         layout: The decision vector's layout.
-        friction: :math:`\\mu` [-].
+        friction: Coulomb coefficient :math:`\\mu` [-].
         min_normal_force: :math:`f_{min}` [N].
         max_normal_force: :math:`f_{max}` [N].
     """
@@ -281,8 +283,8 @@ class FrictionPyramidConstraint(Constraint):
         self._contact_upper = np.tile([0.0, 0.0, 0.0, 0.0, max_normal_force], layout.n_sites)
         self._swing_lower = np.tile([0.0, -INF, 0.0, -INF, 0.0], layout.n_sites)
         self._swing_upper = np.tile([0.0, INF, 0.0, INF, 0.0], layout.n_sites)
-        mu = friction
-        # rows t1 - mu n, -t1 - mu n, t2 - mu n, -t2 - mu n, n of the frame (t1, t2, n)
+        mu = pyramid_slope(friction)
+        # rows t1 - s n, -t1 - s n, t2 - s n, -t2 - s n, n of the frame (t1, t2, n)
         self._pyramid = np.array(
             [[1.0, 0.0, -mu], [-1.0, 0.0, -mu], [0.0, 1.0, -mu], [0.0, -1.0, -mu], [0.0, 0.0, 1.0]]
         )

@@ -61,9 +61,9 @@ class WbcSettings:
         dt: Control period [s] (the joint targets integrate over it).
         track: The point the position targets refer to: ``com`` (centre of mass) or
             ``base`` (base origin).
-        friction: Friction coefficient :math:`\\mu` of the pyramid
-            :math:`|f_{t_k}| \\le \\mu f_n` (its corners reach :math:`\\sqrt2\\,\\mu`; keep it
-            below the true friction).
+        friction: Coulomb friction coefficient :math:`\\mu` [-]; the QP keeps each force in
+            its inner pyramid :math:`|f_{t_k}| \\le (\\mu/\\sqrt2) f_n`
+            (:mod:`ridempc.friction`); keep it below the true friction.
         springs: How the QP treats the description's leaf springs: ``passive`` (known
             torques :math:`-k (q - q_{ref})` from the measured deflection) or ``rigid``
             (held still, their torque free; see

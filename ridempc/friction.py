@@ -1,0 +1,35 @@
+"""The friction pyramid that the planners and controllers put on every contact force.
+
+Coulomb friction :math:`\\mu` lets a contact carry any force :math:`\\phi` (in the surface's
+frame) with :math:`\\lVert(\\phi_x, \\phi_y)\\rVert \\le \\mu\\, \\phi_z`: a circular cone. The
+trajectory optimisation, the MPC and the whole-body QP use the linear pyramid
+
+.. math:: |\\phi_x| \\le s\\, \\phi_z, \\qquad |\\phi_y| \\le s\\, \\phi_z, \\qquad
+          s = \\mu / \\sqrt 2,
+
+the cone's *inner* pyramid: its edges reach :math:`\\lVert(\\phi_x, \\phi_y)\\rVert =
+\\mu\\, \\phi_z`, so every force it allows is inside the cone, however its tangent axes are
+turned. The outer pyramid (:math:`s = \\mu`) reaches :math:`\\sqrt 2\\, \\mu` along its
+diagonals, outside the cone. MuJoCo's own contact (its default pyramidal cone, the four edges
+:math:`n \\pm \\mu_{sim} t_k`) is the diamond :math:`|\\phi_x| + |\\phi_y| \\le \\mu_{sim}
+\\phi_z`, whose inscribed circle has radius :math:`\\mu_{sim} / \\sqrt 2`: with
+:math:`\\mu = 0.6` and the descriptions' :math:`\\mu_{sim} = 1`, the inner pyramid's corner
+sums to 0.85, the outer one's to 1.2.
+
+Found on the skateboard: at the end of its second push the dog's pushing foot carried
+:math:`(\\phi_x, \\phi_y) = (12.4, -12.4)` N on :math:`\\phi_z = 24.9` N, inside the outer
+pyramid of :math:`\\mu = 0.6` (0.50 of :math:`\\phi_z` each way) but on MuJoCo's diamond
+(0.996): the foot slid 6 cm and the dog fell 0.35 s later (push-off-0.7 at 3.41 s).
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["pyramid_slope"]
+
+
+def pyramid_slope(friction: float) -> float:
+    """:math:`s = \\mu / \\sqrt 2` [-], the inner pyramid's bound on each tangential force
+    over the normal force, for the Coulomb friction coefficient ``friction`` [-]."""
+    return friction / math.sqrt(2.0)
