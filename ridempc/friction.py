@@ -16,10 +16,11 @@ diagonals, outside the cone. MuJoCo's own contact (its default pyramidal cone, t
 :math:`\\mu = 0.6` and the descriptions' :math:`\\mu_{sim} = 1`, the inner pyramid's corner
 sums to 0.85, the outer one's to 1.2.
 
-Found on the skateboard: at the end of its second push the dog's pushing foot carried
-:math:`(\\phi_x, \\phi_y) = (12.4, -12.4)` N on :math:`\\phi_z = 24.9` N, inside the outer
-pyramid of :math:`\\mu = 0.6` (0.50 of :math:`\\phi_z` each way) but on MuJoCo's diamond
-(0.996): the foot slid 6 cm and the dog fell 0.35 s later (push-off-0.7 at 3.41 s).
+Found on the skateboard: 3 s into push-off-0.7, at the end of its second push, the dog's
+pushing foot carried :math:`(\\phi_x, \\phi_y) = (12.4, -12.4)` N on :math:`\\phi_z = 24.9` N
+(in a variant of the library that keeps the pusher's knee bent; the committed one let go
+alike at 3.02 s), inside the outer pyramid of :math:`\\mu = 0.6` (0.50 of :math:`\\phi_z` each
+way) but on MuJoCo's diamond (0.996): the foot slid 6 cm and the dog fell within 0.5 s.
 """
 
 from __future__ import annotations
