@@ -26,11 +26,26 @@ way) but on MuJoCo's diamond (0.996): the foot slid 6 cm and the dog fell within
 from __future__ import annotations
 
 import math
+from typing import Any
 
-__all__ = ["pyramid_slope"]
+__all__ = ["pyramid_rows", "pyramid_slope"]
 
 
 def pyramid_slope(friction: float) -> float:
     """:math:`s = \\mu / \\sqrt 2` [-], the inner pyramid's bound on each tangential force
     over the normal force, for the Coulomb friction coefficient ``friction`` [-]."""
     return friction / math.sqrt(2.0)
+
+
+def pyramid_rows(local: Any, friction: float) -> list[Any]:
+    """The inner pyramid's five rows on a force ``local`` = :math:`(\\phi_x, \\phi_y, \\phi_z)`
+    in its surface's frame (NumPy or CasADi), each :math:`\\ge 0` inside it:
+    :math:`\\phi_z,\\ s\\phi_z \\mp \\phi_x,\\ s\\phi_z \\mp \\phi_y`."""
+    s = pyramid_slope(friction)
+    return [
+        local[2],
+        s * local[2] - local[0],
+        s * local[2] + local[0],
+        s * local[2] - local[1],
+        s * local[2] + local[1],
+    ]

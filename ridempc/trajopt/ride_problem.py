@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
-from ridempc.friction import pyramid_slope
+from ridempc.friction import pyramid_rows
 from ridempc.trajopt.platforms import WheeledBoard, platform_pushes, platform_torques
 from ridempc.trajopt.problem import NodeSpec, NodeTerms, TrajectoryProblem, assemble_problem
 from ridempc.trajopt.rider import RiderModel
@@ -274,18 +274,7 @@ def build_ride_problem(
         for k in range(nc):
             plate, _ = board.pose(xb, platform_of[k])
             local = plate.T @ forces[k]
-            mu = pyramid_slope(o.friction)
-            terms.add(
-                ca.vertcat(
-                    local[2],
-                    mu * local[2] - local[0],
-                    mu * local[2] + local[0],
-                    mu * local[2] - local[1],
-                    mu * local[2] + local[1],
-                ),
-                0.0,
-                np.inf,
-            )
+            terms.add(ca.vertcat(*pyramid_rows(local, o.friction)), 0.0, np.inf)
         if math.isfinite(board.yaw_torque_limit):
             torques = platform_torques(board, xb, forces, points, platform_of)
             for _, yaw_torque in torques:

@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
-from ridempc.friction import pyramid_slope
+from ridempc.friction import pyramid_rows
 from ridempc.trajopt.problem import (
     NodeSpec,
     NodeTerms,
@@ -379,14 +379,7 @@ def build_skate_problem(
                 continue
             f = u[3 * i : 3 * i + 3]
             local = (rotation_b if kind is Contact.BOARD else ca.DM.eye(3)).T @ f
-            mu = pyramid_slope(o.friction)
-            cone = ca.vertcat(
-                local[2],
-                mu * local[2] - local[0],
-                mu * local[2] + local[0],
-                mu * local[2] - local[1],
-                mu * local[2] + local[1],
-            )
+            cone = ca.vertcat(*pyramid_rows(local, o.friction))
             least = o.min_board_force * weight_per_foot if kind is Contact.BOARD else 0.0
             terms.add(cone, np.array([least, 0.0, 0.0, 0.0, 0.0]), np.inf)
             leg = list(robot.legs[i])
