@@ -73,7 +73,16 @@ def _parser() -> argparse.ArgumentParser:
         "--pairs", default=None, help="comma-separated robot-board pairs (default: all)"
     )
     bench.add_argument(
-        "--seconds", type=float, default=2.0, help="simulated seconds recorded per pair"
+        "--seconds",
+        type=float,
+        default=None,
+        help="simulated seconds recorded per pair (default: 6)",
+    )
+    bench.add_argument(
+        "--scenario",
+        default=None,
+        help="scenario recorded for every pair (default: each pair's manoeuvre, "
+        "push-off-0.5 on the skateboard, velocity-steps for Cassie)",
     )
     bench.add_argument("--json", type=Path, default=None, help="also write the results here")
 
@@ -144,12 +153,14 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from ridempc.bench import bench
+    from ridempc.bench import DEFAULT_SECONDS, bench
 
+    if args.seconds is None:
+        args.seconds = DEFAULT_SECONDS
     if not args.seconds > 0.0:
         raise ConfigError(f"--seconds {args.seconds}: must be positive")
     pairs = [p.strip() for p in args.pairs.split(",")] if args.pairs else None
-    bench(pairs, seconds=args.seconds, json_path=args.json)
+    bench(pairs, seconds=args.seconds, json_path=args.json, scenario=args.scenario)
     return 0
 
 

@@ -78,6 +78,10 @@ def test_bad_input_is_refused(capsys) -> None:
     assert "cassie-skateboard" in capsys.readouterr().err
     assert main(["bench", "--seconds", "0"]) == 2
     assert "--seconds 0" in capsys.readouterr().err
+    assert main(["bench", "--scenario", "no-such-scenario"]) == 2
+    assert "no-such-scenario" in capsys.readouterr().err
+    assert main(["bench", "--pairs", "cassie-segway", "--scenario", "push-off-0.5"]) == 2
+    assert "push-off-0.5" in capsys.readouterr().err
 
 
 def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:

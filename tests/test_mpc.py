@@ -24,6 +24,7 @@ from ridempc.mpc import (
     linearize,
     load_mpc_pair,
     select_reference,
+    zero_order_hold,
 )
 from ridempc.mpc.friction import ROWS_PER_CONTACT
 from ridempc.mpc.manoeuvre import RETARGET_BAND, Manoeuvre, ManoeuvreSelector, StateLayout
@@ -91,6 +92,31 @@ def test_linearisation_matches_finite_differences(
     drift = _finite_difference(lambda x: np.asarray(rates(x, 0 * u, p)).ravel(), x0)
     np.testing.assert_allclose(jac_held, drift, rtol=1e-5, atol=1e-5)
     assert held.state_pattern.sum() < mpc.model.state_pattern.sum()
+
+
+def test_zero_order_hold_of_badly_scaled_stiff_stacks_matches_expm() -> None:
+    """Balancing and the Paterson-Stockmeyer series change how, not what, is computed: a
+    stack of distinct matrices with units spread over six decades and a -140 rad/s mode
+    (the Segway's platform), and a stack repeating one matrix, against SciPy's expm of
+    the augmented matrix."""
+    rng = np.random.default_rng(3)
+    nx, dt = 8, MPC_STEP
+    units = np.diag(10.0 ** rng.uniform(-3.0, 3.0, nx))
+    base = np.diag([-140.0, -3.0, 0.0, 0.0, 1.5, -0.2, 0.0, -20.0])
+    base[np.triu_indices(nx, 1)] = rng.normal(scale=4.0, size=nx * (nx - 1) // 2)
+    distinct = np.stack(
+        [units @ (base + rng.normal(scale=0.5, size=(nx, nx))) @ np.linalg.inv(units)
+         for _ in range(4)]
+    )  # fmt: skip
+    for stack in (distinct, np.repeat(distinct[:1], 3, axis=0)):
+        exponential, phi = zero_order_hold(stack, dt)
+        for k, a_c in enumerate(stack):
+            augmented = np.zeros((2 * nx, 2 * nx))
+            augmented[:nx, :nx], augmented[:nx, nx:] = a_c * dt, np.eye(nx) * dt
+            exact = expm(augmented)
+            scale_e, scale_phi = np.abs(exact[:nx, :nx]).max(), np.abs(exact[:nx, nx:]).max()
+            np.testing.assert_allclose(exponential[k], exact[:nx, :nx], atol=1e-12 * scale_e)
+            np.testing.assert_allclose(phi[k], exact[:nx, nx:], atol=1e-12 * scale_phi)
 
 
 def _pyramid_violation(problem: MpcProblem, inputs: np.ndarray) -> float:

@@ -460,6 +460,11 @@ class MpcRider(Controller):
     def diagnostics(self) -> dict[str, float]:
         return dict(self._diagnostics)
 
+    @property
+    def mpc_tick_ms(self) -> tuple[float, ...]:
+        """Each MPC tick's wall time so far [ms]: building the problem and solving it."""
+        return tuple(self._mpc_ms)
+
     def summary(self) -> dict[str, Any]:
         """Solve times, fallbacks and the safe hold, for ``summary.json``."""
         out: dict[str, Any] = {}
