@@ -87,6 +87,12 @@ def _stats(values: Sequence[float]) -> tuple[float, float]:
     return float(np.median(ms)), float(np.percentile(ms, 99))
 
 
+def _scenario_of(pair: str, scenario: str | None) -> str:
+    """The scenario recorded for ``pair``: ``scenario`` if given, else its
+    :data:`BENCH_SCENARIOS` entry (``stand-still`` for a pair without one)."""
+    return scenario or BENCH_SCENARIOS.get(pair, "stand-still")
+
+
 def _record(
     robot_name: str, board_name: str, scenario_name: str, seconds: float
 ) -> tuple[Any, list, list, Any, float]:
@@ -357,7 +363,7 @@ def bench_pair(
     from ridempc.wbc import WholeBodyController
 
     name = f"{robot}-{board}"
-    out = PairBench(pair=name, scenario=scenario or BENCH_SCENARIOS.get(name, "stand-still"))
+    out = PairBench(pair=name, scenario=_scenario_of(name, scenario))
     result, problems, wbc_inputs, rider, wall = _record(robot, board, out.scenario, seconds)
     out.ride_status = "fell" if result.fell else result.status
     out.simulated_s = float(result.sim_time)
@@ -374,13 +380,7 @@ def bench_pair(
             times.append(time.perf_counter() - started)
         out.mpc_solve_median_ms, out.mpc_solve_p99_ms = _stats(times)
         out.solvers = _other_solvers(qp, problems)
-        out.solvers["osqp"] = {
-            "solve_median_ms": out.mpc_solve_median_ms,
-            "solve_p99_ms": out.mpc_solve_p99_ms,
-            "failures": int(qp.failures),
-            "objective_gap_max": 0.0,
-            "warm_started": True,
-        }
+        out.solvers["osqp"] = {**_figures(times, [0.0], int(qp.failures)), "warm_started": True}
     if wbc_inputs:
         wbc = WholeBodyController(  # the rider's own: its settings, its rolling platforms
             rider.robot,
@@ -513,7 +513,7 @@ def bench(
             raise UnknownNameError("robot-board pair for the MPC", name, MPC_PAIRS)
     from ridempc.scenarios import resolve_scenario
 
-    recorded = {n: scenario or BENCH_SCENARIOS.get(n, "stand-still") for n in names}
+    recorded = {n: _scenario_of(n, scenario) for n in names}
     for name in names:  # every scenario checked before the first ride
         resolve_scenario(recorded[name], name.split("-", 1)[1])
     rows = []

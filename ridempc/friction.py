@@ -28,7 +28,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["pyramid_rows", "pyramid_slope"]
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["pyramid_matrix", "pyramid_rows", "pyramid_slope"]
 
 
 def pyramid_slope(friction: float) -> float:
@@ -49,3 +52,10 @@ def pyramid_rows(local: Any, friction: float) -> list[Any]:
         s * local[2] - local[1],
         s * local[2] + local[1],
     ]
+
+
+def pyramid_matrix(friction: float) -> NDArray[np.float64]:
+    """:func:`pyramid_rows` as a 5 x 3 matrix :math:`G`, :math:`G \\phi \\ge 0` inside the
+    pyramid (the rows of the identity's columns): for controllers that apply it to many
+    forces at once."""
+    return np.array(pyramid_rows(np.eye(3), friction))

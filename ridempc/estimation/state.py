@@ -54,8 +54,10 @@ class BoardEstimate:
     """A board's platform state seen through the rider's feet standing on it.
 
     The platform frame sits where the stance feet touch: its origin is the centroid of
-    their contact points, its z axis the normal of the plane through them and its x axis
-    the rider's forward direction projected on that plane.
+    their contact points (or, with only some of the platform's feet down, where all of
+    them would put it), its z axis the normal of the plane through them and its x axis the
+    rider's forward direction projected on that plane (or a lone foot's toe line); see
+    :func:`~ridempc.estimation.board.estimate_board`.
 
     Attributes:
         feet: The feet the estimate is taken from.

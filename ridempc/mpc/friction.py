@@ -26,20 +26,13 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.friction import pyramid_slope
+from ridempc.friction import pyramid_matrix
 from ridempc.trajopt.schedule import Contact
 
 __all__ = ["ROWS_PER_CONTACT", "force_bounds", "friction_pyramids", "pyramid_pattern"]
 
 Array = NDArray[np.float64]
 ROWS_PER_CONTACT = 5
-
-# Rows of one pyramid on the local force (phi_x, phi_y, phi_z), with s = 1 for the shape;
-# the s column multiplies phi_z.
-_TANGENT = np.array(
-    [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]]
-)
-_NORMAL = np.array([0.0, -1.0, -1.0, -1.0, -1.0])
 
 
 def pyramid_pattern(force_index: NDArray[np.int64], nu: int) -> NDArray[np.bool_]:
@@ -79,8 +72,9 @@ def friction_pyramids(
     matrix = np.zeros((n, rows, nu))
     lower = np.full((n, rows), -np.inf)
     upper = np.zeros((n, rows))
-    local = _TANGENT.copy()
-    local[:, 2] += pyramid_slope(friction) * _NORMAL  # rows on phi: (phi_z, phi_x - s phi_z, ...)
+    # rows on phi: (phi_z, phi_x - s phi_z, ...), the tangent rows <= 0 (0.0 - x: no -0.0)
+    local = pyramid_matrix(friction)
+    local[1:] = 0.0 - local[1:]
     kinds = np.array([[kind.value for kind in step] for step in schedule]).reshape(n, nc)
     on_board = kinds == Contact.BOARD.value
     standing = kinds != Contact.SWING.value

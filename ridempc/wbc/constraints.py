@@ -17,7 +17,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.friction import pyramid_slope
+from ridempc.friction import pyramid_matrix
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
@@ -283,11 +283,9 @@ class FrictionPyramidConstraint(Constraint):
         self._contact_upper = np.tile([0.0, 0.0, 0.0, 0.0, max_normal_force], layout.n_sites)
         self._swing_lower = np.tile([0.0, -INF, 0.0, -INF, 0.0], layout.n_sites)
         self._swing_upper = np.tile([0.0, INF, 0.0, INF, 0.0], layout.n_sites)
-        mu = pyramid_slope(friction)
+        pyramid = pyramid_matrix(friction)
         # rows t1 - s n, -t1 - s n, t2 - s n, -t2 - s n, n of the frame (t1, t2, n)
-        self._pyramid = np.array(
-            [[1.0, 0.0, -mu], [-1.0, 0.0, -mu], [0.0, 1.0, -mu], [0.0, -1.0, -mu], [0.0, 0.0, 1.0]]
-        )
+        self._pyramid = np.vstack([0.0 - pyramid[1:], pyramid[:1]])  # (no negative zeros)
 
     def compute_qp_constraint(
         self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
