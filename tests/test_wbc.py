@@ -421,6 +421,7 @@ def test_motor_command_carries_torques_and_targets() -> None:
         acceleration=np.zeros(9),
         forces=np.zeros((1, 3)),
         site_forces=np.zeros((1, 3)),
+        site_positions=np.zeros((1, 3)),
         loop_forces=np.zeros(0),
         status="solved",
         iterations=10,

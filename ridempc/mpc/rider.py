@@ -12,6 +12,9 @@ Every 2 ms (500 Hz) the rider
    (:class:`~ridempc.mpc.controller.LinearMpc`) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
+   on the Hovershoes the MPC also sees where each foot stands along its shoe and each
+   shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
+   :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz;
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
    the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
@@ -58,6 +61,7 @@ from ridempc.mpc.manoeuvre import YAW_RATE_SUFFIXES, Manoeuvre, ManoeuvreSelecto
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
@@ -188,6 +192,7 @@ class MpcRider(Controller):
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
+        self.shoes = self._shoe_observer(loaded)
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -209,6 +214,30 @@ class MpcRider(Controller):
         self._mpc_ms: list[float] = []
         self._wbc_ms: list[float] = []
         self._diagnostics: dict[str, float] = {}
+
+    def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
+        """On Hovershoes, the observer of where each foot stands along its shoe and of each
+        shoe's drag."""
+        if board is None or not isinstance(board.params, HovershoesParameters):
+            return None
+        shoes = wheeled_board(board)
+        assert isinstance(shoes, HovershoesBoard)
+        names = self.wbc.model.foot_names
+        platform_of = {foot: k for k, group in enumerate(self.platform_feet) for foot in group}
+        sites = [platform_of.get(names[f], -1) for f in self.wbc.model.site_foot]
+        return ShoeObserver(shoes, sites)
+
+    @property
+    def _shoe_columns(self) -> tuple[tuple[int, int, int, int], ...]:
+        """Each platform's (x, y, heading, speed) indices in the MPC's state."""
+        n = self.layout.names
+        return tuple(
+            (n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes
+        )
+
+    def _mapped(self, estimate: EstimatedState) -> EstimatedState:
+        """The estimate as the MPC sees it: each Hovershoe's origin on its axis."""
+        return estimate if self.shoes is None else self.shoes.shift(estimate)
 
     def _contacts_to_feet(self, contacts: tuple[str, ...]) -> list[int]:
         """The foot (``foot_bodies`` index) each library contact belongs to."""
@@ -236,7 +265,7 @@ class MpcRider(Controller):
         self.manoeuvre = self.manoeuvre.started(now)
         state = self.mpc.reference.states_at(np.array([self.manoeuvre.reference_time(now)]))[0]
         pose = self.layout.board_pose(state)
-        self.map.anchor(estimate, pose)
+        self.map.anchor(self._mapped(estimate), pose)
 
     def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
         if self._hold is None:
@@ -294,8 +323,9 @@ class MpcRider(Controller):
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
         turn = self._yaw_rate_horizon(command, now)
-        self._follow_board(estimate, t_ref, turn, now)
-        x0 = self.map.state(estimate)
+        mapped = self._mapped(estimate)
+        self._follow_board(mapped, t_ref, turn, now)
+        x0 = self.map.state(mapped)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
         names, roll = self.layout.names, self._roll_horizon(command, now, problem)
@@ -304,6 +334,11 @@ class MpcRider(Controller):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
         problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
+        if self.shoes is not None:
+            columns = self._shoe_columns
+            states = self.shoes.shift_reference(problem.state_reference, columns)
+            c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
+            problem = replace(problem, state_reference=states, c=c)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem
@@ -448,6 +483,8 @@ class MpcRider(Controller):
             posture=posture,
         )
         out = self.wbc.solve(estimate, targets)
+        if self.shoes is not None:
+            self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
         self._diagnostics.update(wbc_ms=self._wbc_ms[-1])
         return to_motor_command(out, self.kp, self.kd)

@@ -45,7 +45,7 @@ from ridempc.wbc.constraints import (
     TorqueLimitConstraint,
 )
 from ridempc.wbc.contacts import ContactSet, build_contact_set
-from ridempc.wbc.model import WholeBodyModel
+from ridempc.wbc.model import ModelTerms, WholeBodyModel
 from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import QpProblem, QpSolution, WholeBodyQP
 from ridempc.wbc.settings import WbcSettings
@@ -243,12 +243,11 @@ class WholeBodyController:
         solution = self.qp.solve(problem)
         end = time.perf_counter()
         self.last_problem, self.last_solution = problem, solution
-        return self._output(terms.q, terms.v, solution, start, model_time, build_time, end)
+        return self._output(terms, solution, start, model_time, build_time, end)
 
     def _output(
         self,
-        q: Array,
-        v: Array,
+        terms: ModelTerms,
         solution: QpSolution,
         start: float,
         model_time: float,
@@ -256,6 +255,7 @@ class WholeBodyController:
         end: float,
     ) -> WbcOutput:
         layout, dt = self.model.layout, self.settings.dt
+        q, v = terms.q, terms.v
         x = solution.x
         acceleration = x[layout.acceleration]
         site_forces = x[layout.force].reshape(-1, 3)
@@ -269,6 +269,7 @@ class WholeBodyController:
             acceleration=acceleration.copy(),
             forces=feet,
             site_forces=site_forces.copy(),
+            site_positions=terms.sites.position,
             loop_forces=x[layout.loop_force].copy(),
             status=solution.status,
             iterations=solution.iterations,

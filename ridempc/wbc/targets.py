@@ -128,6 +128,8 @@ class WbcOutput:
         acceleration: The solution's :math:`\\ddot q` (Pinocchio coordinates).
         forces: The support's force on each foot [N], shape (feet, 3).
         site_forces: On each contact site [N], shape (sites, 3).
+        site_positions: Where each contact site is at the estimated state [m], world, shape
+            (sites, 3).
         loop_forces: Closed-chain constraint forces :math:`\\lambda` [N].
         status: OSQP's status (``solved`` or ``solved inaccurate``).
         iterations: ADMM iterations.
@@ -142,6 +144,7 @@ class WbcOutput:
     acceleration: Array
     forces: Array
     site_forces: Array
+    site_positions: Array
     loop_forces: Array
     status: str
     iterations: int

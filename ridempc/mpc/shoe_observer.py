@@ -1,0 +1,220 @@
+"""What the Hovershoes' reduced model misses under a rider: where each foot stands along its
+shoe (eq. (4)'s balance) and the drag on each shoe (eq. (8)'s), the MPC's disturbance estimate.
+
+**Where the foot stands.** The rider's feet tell the estimator each shoe's pitch, heading
+and velocity, but not where the shoe's pitch axis lies under the foot: the platform
+estimate's origin is the foot's own contact centroid :math:`c`
+(:mod:`ridempc.estimation.board`). A foot that stands :math:`d` [m] ahead of the axis presses
+the nose down with :math:`d\\,N` [N m] (:math:`N` [N] its load), which the MPC's model, with
+:math:`d = 0`, does not see: a foot 4 cm ahead of the axis under a 160 N load is 6.4 N m, a
+static pitch of :math:`6.4 / c_1 = 0.14` rad and a speed-up of :math:`c_4\\,0.14/m = 3`
+m/s^2 (the offset start: the right shoe, 3 cm behind the left, ran off in 0.2 s). Per shoe,
+eq. (4) with the rider's torque about the foot's centroid :math:`u_\\theta(c)` and the
+offset's:
+
+.. math::
+
+    J_\\theta \\ddot\\theta + c_2 \\dot\\theta + c_1 \\theta = u_\\theta(c) + d\\,N,
+    \\qquad u_\\theta(c) = y_P^\\top \\sum_i (p_i - c) \\times (-F_i),
+    \\qquad N = \\sum_i F_{i,z},
+
+with :math:`p_i` [m] the foot's contact sites and :math:`F_i` [N] the support's force on
+them (the whole-body QP's, which the motors apply), :math:`y_P` the shoe's lateral axis and
+:math:`\\theta` [rad] its estimated pitch (nose down positive).
+
+**Drag.** Eq. (8) with the rider's push (:class:`~ridempc.trajopt.platforms.HovershoesBoard`)
+and a force :math:`D` [N] along the heading that it leaves out (rolling resistance, and what
+the firmware does beyond :math:`c_4\\theta`):
+
+.. math:: m_s \\dot v = c_4 \\theta + P + D, \\qquad
+    P = -\\sum_i x_P^\\top F_i,
+
+:math:`x_P` the shoe's forward axis, :math:`m_s` [kg] the bare shoe. Without it the MPC held
+its shoes level at 0.5 m/s and the speed sagged to 0.35 m/s.
+
+**Fitting.** The pitch, the speed, the torque, the push and the load pass through the same
+critically damped second-order low-pass at ``FILTER_HZ``, whose states give the filtered
+angle, speed and their rates without differentiating noise. The residuals of the two
+balances are fitted by least squares with exponential forgetting over ``MEMORY``
+(:math:`\\lambda = e^{-\\Delta t / T}`), to a constant offset and a constant drag:
+
+.. math::
+
+    b_k = J_\\theta \\ddot{\\bar\\theta}_k + c_2 \\dot{\\bar\\theta}_k
+        + c_1 \\bar\\theta_k - \\bar u_{\\theta,k}, \\qquad
+    d = \\frac{\\sum_k \\lambda^{K-k} \\bar N_k b_k}{\\sum_k \\lambda^{K-k} \\bar N_k^2},
+    \\qquad
+    D = \\frac{\\sum_k \\lambda^{K-k} (m_s \\dot{\\bar v}_k - c_4 \\bar\\theta_k
+        - \\bar P_k)}{\\sum_k \\lambda^{K-k}},
+
+over the ticks with a load over ``MIN_LOAD``, :math:`d` held within ``LIMIT``. Early in a
+ride the fit rests on the few ticks it has and finds a misplaced foot within a tenth of a
+second; later it averages over :math:`T`: fitted tick by tick at 4 Hz, the offset rang with
+the shoes' 4 Hz pitch and fed it (stand-still's yaw-rate RMSE 0.034 -> 0.12 rad/s).
+
+**Use.** The MPC sees each shoe's axis :math:`d` behind its foot (:meth:`ShoeObserver.shift`),
+wants it :math:`d` behind where the reference puts the foot
+(:meth:`ShoeObserver.shift_reference`: the library's shoes carry their feet over their axes,
+and held to the library's shoes side by side, a rider on shoes staggered by 6 cm scissored
+her feet 10 cm apart to line the axes up and fell at 3.65 s), and has :math:`D` in its
+speed equations (:meth:`ShoeObserver.speed_drift`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.estimation.state import BoardEstimate, EstimatedState
+from ridempc.trajopt.platforms import HovershoesBoard
+
+__all__ = ["FILTER_HZ", "LIMIT", "MEMORY", "MIN_LOAD", "WARM_UP", "ShoeObserver"]
+
+Array = NDArray[np.float64]
+FILTER_HZ: float = 4.0  # [Hz] natural frequency of the critically damped low-pass
+LIMIT: float = 0.08  # [m] |d| at most: half of Cassie's toe line
+MIN_LOAD: float = 20.0  # [N] below this filtered load the offset is not updated
+MEMORY: float = 1.0  # [s] forgetting time of the least squares
+WARM_UP: float = 0.05  # [s] the low-pass settles from its first sample before it is fitted
+
+
+class _SecondOrder:
+    """Critically damped low-pass :math:`\\ddot y = \\omega^2 (u - y) - 2\\omega\\dot y`,
+    semi-implicit Euler, per channel; starts at its first input, at rest."""
+
+    def __init__(self, hz: float) -> None:
+        self.omega = 2.0 * math.pi * hz
+        self.y: Array | None = None
+        self.dy = np.zeros(0)
+        self.ddy = np.zeros(0)
+
+    def __call__(self, u: Array, dt: float) -> None:
+        if self.y is None:
+            self.y, self.dy, self.ddy = u.copy(), np.zeros_like(u), np.zeros_like(u)
+            return
+        w = self.omega
+        self.ddy = w * w * (u - self.y) - 2.0 * w * self.dy
+        self.dy = self.dy + dt * self.ddy
+        self.y = self.y + dt * self.dy
+
+
+class ShoeObserver:
+    """Each foot's offset ahead of its shoe's pitch axis and each shoe's drag (the module
+    docstring).
+
+    Args:
+        shoes: The shoes' identified model as the MPC has it.
+        site_platform: The platform each contact site stands on (-1: none), WBC site order.
+        hz: The low-pass's natural frequency [Hz].
+        memory: The least squares' forgetting time [s].
+        warm_up: Time the low-pass runs before its output is fitted [s].
+    """
+
+    def __init__(
+        self,
+        shoes: HovershoesBoard,
+        site_platform: Sequence[int],
+        hz: float = FILTER_HZ,
+        memory: float = MEMORY,
+        warm_up: float = WARM_UP,
+    ) -> None:
+        self.params, self.shoe_mass = shoes.reduced, shoes.shoe_mass
+        self.site_platform = np.asarray(site_platform, dtype=np.int64)
+        self.platforms = int(self.site_platform.max()) + 1
+        self._filter = _SecondOrder(hz)
+        self.memory, self.warm_up = memory, warm_up
+        self._time: float | None = None
+        self._start = 0.0
+        n = self.platforms
+        self._moment = np.zeros(n)  # [N^2 m] sum of w N b
+        self._load = np.zeros(n)  # [N^2] sum of w N^2
+        self._force = np.zeros(n)  # [N] sum of w (m v' - c4 theta - P)
+        self._weight = np.zeros(n)  # [-] sum of w
+        self.offsets = np.zeros(n)  # [m] d per platform
+        self.drag = np.zeros(n)  # [N] D per platform
+
+    def update(
+        self,
+        estimate: EstimatedState,
+        site_positions: Array,
+        site_forces: Array,
+    ) -> None:
+        """Fold in one tick: the estimate's platforms and the forces the rider applied on its
+        sites since the last one (world, shapes (sites, 3)); updates :attr:`offsets` [m] and
+        :attr:`drag` [N]."""
+        boards = estimate.boards
+        n = self.platforms
+        if len(boards) != n:
+            return
+        pitch, speed, torque, push, load = (np.zeros(n) for _ in range(5))
+        for k, board in enumerate(boards):
+            sites = self.site_platform == k
+            r, g = site_positions[sites] - board.position, -site_forces[sites]
+            mx = r[:, 1] * g[:, 2] - r[:, 2] * g[:, 1]  # (r x g), np.cross costs 30 us
+            my = r[:, 2] * g[:, 0] - r[:, 0] * g[:, 2]
+            cos, sin = math.cos(board.yaw), math.sin(board.yaw)
+            torque[k] = float((cos * my - sin * mx).sum())
+            total = g.sum(axis=0)
+            along = cos * total[0] + sin * total[1]
+            push[k] = math.cos(board.pitch) * along - math.sin(board.pitch) * total[2]
+            load[k] = -float(total[2])
+            pitch[k] = board.pitch
+            speed[k] = cos * board.velocity[0] + sin * board.velocity[1]
+        if self._time is None:
+            self._start = self._time = estimate.time
+        dt = estimate.time - self._time
+        self._time = estimate.time
+        self._filter(np.concatenate([pitch, speed, torque, push, load]), dt)
+        f, p = self._filter, self.params
+        assert f.y is not None
+        theta, theta_dot, theta_ddot = f.y[:n], f.dy[:n], f.ddy[:n]
+        accel = f.dy[n : 2 * n]
+        u, pushed, weight = f.y[2 * n : 3 * n], f.y[3 * n : 4 * n], f.y[4 * n :]
+        if estimate.time - self._start < self.warm_up:
+            return
+        balance = p.J_theta * theta_ddot + p.c2 * theta_dot + p.c1 * theta - u
+        residual = self.shoe_mass * accel - p.c4 * theta - pushed
+        forget = math.exp(-dt / self.memory)
+        on = weight > MIN_LOAD
+        self._moment = forget * self._moment + np.where(on, weight * balance, 0.0)
+        self._load = forget * self._load + np.where(on, weight * weight, 0.0)
+        self._force = forget * self._force + np.where(on, residual, 0.0)
+        self._weight = forget * self._weight + np.where(on, 1.0, 0.0)
+        fitted = self._load > 0.0
+        ratio = self._moment / np.where(fitted, self._load, 1.0)
+        self.offsets = np.where(fitted, np.clip(ratio, -LIMIT, LIMIT), self.offsets)
+        self.drag = np.where(fitted, self._force / np.where(fitted, self._weight, 1.0), self.drag)
+
+    def speed_drift(self, c: Array, dt: float, speeds: Sequence[int]) -> Array:
+        """The MPC's affine terms ``c`` (N x nx) with each shoe's drag in its speed equation,
+        :math:`c_{k,v} \\mathrel{+}= D\\,\\Delta t / m_s` (``speeds``: each platform's speed
+        index; ``dt`` [s] the MPC's step). The drag's share of the position over one step,
+        :math:`D\\,\\Delta t^2 / 2 m_s`, is left out: under 1 mm at 5 N."""
+        out = np.array(c, dtype=float)
+        out[:, list(speeds)] += self.drag * dt / self.shoe_mass
+        return out
+
+    def shift_reference(self, states: Array, columns: Sequence[Sequence[int]]) -> Array:
+        """A copy of the MPC's reference ``states`` (nodes x nx) with each shoe moved
+        :math:`d` back along its heading: ``columns`` holds each platform's (x, y, heading,
+        ...) state indices."""
+        out = np.array(states, dtype=float)
+        for (x, y, heading, *_), d in zip(columns, self.offsets, strict=True):
+            out[:, x] -= d * np.cos(out[:, heading])
+            out[:, y] -= d * np.sin(out[:, heading])
+        return out
+
+    def shift(self, estimate: EstimatedState) -> EstimatedState:
+        """The estimate with each platform's origin on its shoe's axis: :math:`d` behind the
+        foot along the shoe's heading."""
+        if len(estimate.boards) != self.platforms:
+            return estimate
+        boards: list[BoardEstimate] = []
+        for board, d in zip(estimate.boards, self.offsets, strict=True):
+            heading = np.array([math.cos(board.yaw), math.sin(board.yaw), 0.0])
+            boards.append(replace(board, position=board.position - d * heading))
+        return replace(estimate, boards=tuple(boards))
