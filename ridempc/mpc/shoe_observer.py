@@ -125,6 +125,9 @@ class ShoeObserver:
         self.params, self.shoe_mass = shoes.reduced, shoes.shoe_mass
         self.site_platform = np.asarray(site_platform, dtype=np.int64)
         self.platforms = int(self.site_platform.max()) + 1
+        self._sites = [
+            np.flatnonzero(self.site_platform == k).tolist() for k in range(self.platforms)
+        ]
         self._filter = _SecondOrder(hz)
         self.memory, self.warm_up = memory, warm_up
         self._time: float | None = None
@@ -150,44 +153,54 @@ class ShoeObserver:
         n = self.platforms
         if len(boards) != n:
             return
-        pitch, speed, torque, push, load = (np.zeros(n) for _ in range(5))
+        # Plain floats: two shoes of two sites each, where NumPy's per-call cost dominates.
+        positions, forces = site_positions.tolist(), site_forces.tolist()
+        pitch, speed, torque, push, load = ([0.0] * n for _ in range(5))
         for k, board in enumerate(boards):
-            sites = self.site_platform == k
-            r, g = site_positions[sites] - board.position, -site_forces[sites]
-            mx = r[:, 1] * g[:, 2] - r[:, 2] * g[:, 1]  # (r x g), np.cross costs 30 us
-            my = r[:, 2] * g[:, 0] - r[:, 0] * g[:, 2]
+            cx, cy, cz = board.position.tolist()
             cos, sin = math.cos(board.yaw), math.sin(board.yaw)
-            torque[k] = float((cos * my - sin * mx).sum())
-            total = g.sum(axis=0)
-            along = cos * total[0] + sin * total[1]
-            push[k] = math.cos(board.pitch) * along - math.sin(board.pitch) * total[2]
-            load[k] = -float(total[2])
+            fx = fy = fz = tau = 0.0
+            for i in self._sites[k]:
+                (px, py, pz), (gx, gy, gz) = positions[i], forces[i]  # g: on the rider
+                rx, ry, rz = px - cx, py - cy, pz - cz
+                # lateral axis . (r x (-g)): the rider's torque on the shoe about its axis
+                tau -= cos * (rz * gx - rx * gz) - sin * (ry * gz - rz * gy)
+                fx, fy, fz = fx + gx, fy + gy, fz + gz
+            vx, vy = board.velocity[0], board.velocity[1]
+            torque[k] = tau
+            push[k] = -(math.cos(board.pitch) * (cos * fx + sin * fy) - math.sin(board.pitch) * fz)
+            load[k] = fz
             pitch[k] = board.pitch
-            speed[k] = cos * board.velocity[0] + sin * board.velocity[1]
+            speed[k] = float(cos * vx + sin * vy)
         if self._time is None:
             self._start = self._time = estimate.time
         dt = estimate.time - self._time
         self._time = estimate.time
-        self._filter(np.concatenate([pitch, speed, torque, push, load]), dt)
+        self._filter(np.array(pitch + speed + torque + push + load), dt)
         f, p = self._filter, self.params
         assert f.y is not None
-        theta, theta_dot, theta_ddot = f.y[:n], f.dy[:n], f.ddy[:n]
-        accel = f.dy[n : 2 * n]
-        u, pushed, weight = f.y[2 * n : 3 * n], f.y[3 * n : 4 * n], f.y[4 * n :]
+        y, dy, ddy = f.y.tolist(), f.dy.tolist(), f.ddy.tolist()
+        theta, theta_dot, theta_ddot = y[:n], dy[:n], ddy[:n]
+        accel = dy[n : 2 * n]
+        u, pushed, weight = y[2 * n : 3 * n], y[3 * n : 4 * n], y[4 * n :]
         if estimate.time - self._start < self.warm_up:
             return
-        balance = p.J_theta * theta_ddot + p.c2 * theta_dot + p.c1 * theta - u
-        residual = self.shoe_mass * accel - p.c4 * theta - pushed
         forget = math.exp(-dt / self.memory)
-        on = weight > MIN_LOAD
-        self._moment = forget * self._moment + np.where(on, weight * balance, 0.0)
-        self._load = forget * self._load + np.where(on, weight * weight, 0.0)
-        self._force = forget * self._force + np.where(on, residual, 0.0)
-        self._weight = forget * self._weight + np.where(on, 1.0, 0.0)
-        fitted = self._load > 0.0
-        ratio = self._moment / np.where(fitted, self._load, 1.0)
-        self.offsets = np.where(fitted, np.clip(ratio, -LIMIT, LIMIT), self.offsets)
-        self.drag = np.where(fitted, self._force / np.where(fitted, self._weight, 1.0), self.drag)
+        for k in range(n):
+            self._moment[k] *= forget
+            self._load[k] *= forget
+            self._force[k] *= forget
+            self._weight[k] *= forget
+            if weight[k] > MIN_LOAD:
+                balance = p.J_theta * theta_ddot[k] + p.c2 * theta_dot[k] + p.c1 * theta[k] - u[k]
+                residual = self.shoe_mass * accel[k] - p.c4 * theta[k] - pushed[k]
+                self._moment[k] += weight[k] * balance
+                self._load[k] += weight[k] * weight[k]
+                self._force[k] += residual
+                self._weight[k] += 1.0
+            if self._load[k] > 0.0:
+                self.offsets[k] = min(max(self._moment[k] / self._load[k], -LIMIT), LIMIT)
+                self.drag[k] = self._force[k] / self._weight[k]
 
     def speed_drift(self, c: Array, dt: float, speeds: Sequence[int]) -> Array:
         """The MPC's affine terms ``c`` (N x nx) with each shoe's drag in its speed equation,
