@@ -70,6 +70,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.estimation.state import BoardEstimate, EstimatedState
+from ridempc.mpc.state_map import forward_speed
 from ridempc.trajopt.platforms import HovershoesBoard
 
 __all__ = ["FILTER_HZ", "LIMIT", "MEMORY", "MIN_LOAD", "WARM_UP", "ShoeObserver"]
@@ -166,12 +167,11 @@ class ShoeObserver:
                 # lateral axis . (r x (-g)): the rider's torque on the shoe about its axis
                 tau -= cos * (rz * gx - rx * gz) - sin * (ry * gz - rz * gy)
                 fx, fy, fz = fx + gx, fy + gy, fz + gz
-            vx, vy = board.velocity[0], board.velocity[1]
             torque[k] = tau
             push[k] = -(math.cos(board.pitch) * (cos * fx + sin * fy) - math.sin(board.pitch) * fz)
             load[k] = fz
             pitch[k] = board.pitch
-            speed[k] = float(cos * vx + sin * vy)
+            speed[k] = forward_speed(board)
         if self._time is None:
             self._start = self._time = estimate.time
         dt = estimate.time - self._time
