@@ -532,6 +532,37 @@ def test_a_commanded_turn_lays_an_arc_over_the_reference() -> None:
         np.testing.assert_allclose(xy[0], before[0, [n[f"{prefix}x"], n[f"{prefix}y"]]])
 
 
+def test_a_coasting_rider_slows_the_steady_ride_to_the_board(skate_mpc: LinearMpc) -> None:
+    """``coasting``: past the push-off's end the skateboard's steady ride is slowed to the
+    board's speed: half the speed halves the rider's and the board's speeds and the steps
+    of their positions from node 0, and leaves the rest (height, roll, joints); at rest
+    it stands. Only the pairs without ``stop`` entries coast."""
+    layout = StateLayout.from_names(skate_mpc.reference.state_names)
+    n = layout.names
+    end = float(skate_mpc.reference.times[-1])
+    problem = skate_mpc.problem(end + 1.0, skate_mpc.reference.states[-1])
+    before = problem.state_reference
+    target = before[0, n["board_v"]]
+    assert target == pytest.approx(0.3, abs=0.02)
+    half = ManoeuvreSelector.coasting(problem, layout, 0.5 * target).state_reference
+    for name in ("vx", "board_v"):
+        np.testing.assert_allclose(half[:, n[name]], 0.5 * before[:, n[name]])
+    for name in ("com_x", "board_x"):
+        np.testing.assert_allclose(np.diff(half[:, n[name]]), 0.5 * np.diff(before[:, n[name]]))
+        assert half[0, n[name]] == before[0, n[name]]
+    others = [
+        i
+        for name, i in n.items()
+        if name not in ("vx", "vy", "board_v") and not name.endswith(("_x", "_y"))
+    ]
+    np.testing.assert_array_equal(half[:, others], before[:, others])
+    rest = ManoeuvreSelector.coasting(problem, layout, -0.01).state_reference
+    assert not rest[:, [n["vx"], n["vy"], n["board_v"]]].any()
+    np.testing.assert_allclose(rest[:, n["board_x"]], before[0, n["board_x"]])
+    assert ManoeuvreSelector("cyberdog2", "skateboard").coasts
+    assert not ManoeuvreSelector("cassie", "hovershoes").coasts
+
+
 def test_swing_targets_follow_the_reference_feet_carried_by_the_board(
     skate_mpc: LinearMpc,
 ) -> None:

@@ -17,6 +17,7 @@ from ridempc.mpc.state_map import HEADING_FILTER_S
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
 from ridempc.trajopt.schedule import Contact
@@ -91,8 +92,16 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     times = now + problem.dt * np.arange(problem.state_reference.shape[0])
     wanted = np.array([scenario.command_at(float(t)).roll for t in times])
     assert np.ptp(wanted) > 0.05  # the command moves over the horizon
-    roll = rider._roll_horizon(scenario.command_at(now), now, problem)
+    roll = rider._roll_horizon(scenario.command_at(now), now)
     np.testing.assert_allclose(roll, wanted)
+    # the deck's roll steers the board (eq. 14): the turn it makes at 0.5 m/s, none at rest
+    gain = rider._steer_gain
+    assert gain == load_board("skateboard").params.reduced.steer_gain  # identified [1/m]
+    steps = mpc.settings.horizon
+    turn = rider._roll_turn(roll, 0.5)
+    np.testing.assert_allclose(turn, -gain * 0.5 * np.sin(wanted[:steps]))
+    assert not rider._roll_turn(roll, 0.0).any()
+    assert not rider._roll_turn(np.zeros_like(roll), 0.5).any()
     laid = rider.selector.with_command(problem, names, roll)
     np.testing.assert_allclose(laid.state_reference[:, names["board_roll"]], wanted)
     np.testing.assert_allclose(
@@ -100,8 +109,8 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     )
     rider.command_preview = None
     step = 1.0 / 30.0
-    rider._roll_horizon(scenario.command_at(now - step), now - step, problem)
-    blind = rider._roll_horizon(scenario.command_at(now), now, problem)
+    rider._roll_horizon(scenario.command_at(now - step), now - step)
+    blind = rider._roll_horizon(scenario.command_at(now), now)
     assert blind[0] == pytest.approx(wanted[0])
     assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend
 
@@ -187,6 +196,34 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
     # deck for ground pushed it 0.28 m/s past the plan by 2.4 s)
     after = [abs(s[3] - s[4]) for s in steps if s[0] > 2.0]
     assert max(after) < 0.1, max(after)  # [m/s]
+
+
+def test_a_push_off_reaches_its_target_and_coasts_on(dog) -> None:
+    """push-off-0.3: at the end of the library's push-off (2.9 s) the board runs within 10 %
+    of 0.3 m/s (0.276 m/s measured), and the rider then coasts on four legs: the MPC's
+    reference speed is the board's own, the library frame follows the board along its
+    line, and the rider stays up."""
+    rider = MpcRider(dog, "skateboard")
+    scenario = resolve_scenario("push-off-0.3", "skateboard").with_duration(4.0)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    n = rider.layout.names
+    coasting: list[tuple[float, float, float]] = []  # t, reference board speed, estimate's
+    mpc_tick = rider._mpc_tick
+
+    def recording(estimate, command, now):
+        mpc_tick(estimate, command, now)
+        problem = rider._last_problem
+        if rider._coasting(rider.manoeuvre.reference_time(now)):
+            coasting.append((now, problem.state_reference[0, n["board_v"]], rider._speed(estimate)))
+
+    rider._mpc_tick = recording
+    result = Simulation(scene, rider, scenario).run()
+    assert result.status == "ok", result.fall_reason
+    summary = run_metrics(result, scenario, dog)
+    assert summary["final_velocity"] == pytest.approx(0.3, rel=0.1)
+    assert coasting and coasting[0][0] == pytest.approx(2.9, abs=0.04)
+    for _, reference, speed in coasting:
+        assert reference == pytest.approx(max(speed, 0.0), abs=1e-9)
 
 
 def _deck_foot_drift(scene, log, sites: tuple[str, ...], until: float = np.inf) -> dict[str, float]:

@@ -100,7 +100,7 @@ def test_command_timeline_steps_and_ramps(tmp_path: Path) -> None:
 
 
 def test_each_skateboard_library_target_has_a_push_off_scenario() -> None:
-    """``push-off-<target>`` for each committed entry, judged after the entry's push-off."""
+    """``push-off-<target>`` for each committed entry, judged at the end of the entry's push-off."""
     from ridempc.library.store import library_folder, load_library
 
     _, entries = load_library(library_folder("cyberdog2", "skateboard"))
@@ -108,7 +108,8 @@ def test_each_skateboard_library_target_has_a_push_off_scenario() -> None:
         scenario = resolve_scenario(f"push-off-{entry.record.target:.1f}", "skateboard")
         assert scenario.push_off is not None
         assert scenario.push_off.target == pytest.approx(entry.record.target)
-        push_off_end = entry.record.n_intervals * entry.record.dt
-        assert scenario.push_off.judged_at > push_off_end
+        start = next(e.t for e in scenario.commands if e.velocity == entry.record.target)
+        push_off_end = start + entry.record.n_intervals * entry.record.dt
+        assert scenario.push_off.judged_at == pytest.approx(push_off_end)
         assert scenario.command_at(scenario.push_off.judged_at).velocity == entry.record.target
         assert scenario.metrics_start > scenario.push_off.judged_at  # roll tracking after it

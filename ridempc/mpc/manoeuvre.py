@@ -8,7 +8,9 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
 - **accelerate** to the commanded speed :math:`v^*` [m/s] (the nearest entry, or a blend of
   the two neighbouring ones where the library allows it), started *at the phase where the
   reference's speed equals the board's estimated speed*, so a step from 0.5 to 1.0 m/s picks
-  up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily;
+  up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily
+  (where the library has no ``stop``, the skateboard, which only a push drives, it
+  **coasts**: the steady ride slowed to the board's speed, :meth:`ManoeuvreSelector.coasting`);
   while the command is ramping, it is kept as long as the command stays within
   ``RETARGET_BAND`` of its target (a ramp retargets in a few steps, not at every tick), and
   it moves to the exact command once the command settles; a lower speed that is not rest
@@ -211,6 +213,37 @@ class ManoeuvreSelector:
         else:
             t_match = float(times[reached[0]]) if reached.size else 0.0
         return now - t_match
+
+    @property
+    def coasts(self) -> bool:
+        """Whether the rider coasts after an ``accelerate``: a pair without ``stop`` entries
+        (the skateboard), whose board the rider drives only by pushing off the ground."""
+        return "stop" not in self.targets
+
+    @staticmethod
+    def coasting(problem: MpcProblem, layout: StateLayout, speed: float) -> MpcProblem:
+        """The steady ride after an ``accelerate``'s end slowed to the board's ``speed``
+        [m/s]: a board that nothing pushes coasts (on the skateboard, rolling resistance
+        takes 0.16 m/s off every second), and a reference riding on at the target asked
+        the rider to drive a deck it stands on.
+
+        With :math:`r = \\max(v, 0) / v_{ref}` (:math:`v_{ref}` the reference's board speed
+        at node 0; :math:`r = 0` at rest), the horizontal speeds of the centre of mass and
+        of every platform are scaled by :math:`r` and the horizontal positions' steps from
+        node 0 too: :math:`p_k = p_0 + r (p^{ref}_k - p_0)`. The rider's pose, the forces
+        and the deck's roll are the reference's.
+        """
+        names = layout.names
+        states = problem.state_reference.copy()
+        reference = float(states[0, names[f"{layout.prefixes[0]}v"]])
+        ratio = max(speed, 0.0) / reference if reference > MOVING else 0.0
+        for prefix in ("com_", *layout.prefixes):
+            for axis in ("x", "y"):
+                i = names[f"{prefix}{axis}"]
+                states[:, i] = states[0, i] + ratio * (states[:, i] - states[0, i])
+        for name in ("vx", "vy", *(f"{p}v" for p in layout.prefixes)):
+            states[:, names[name]] *= ratio
+        return replace(problem, state_reference=states)
 
     @staticmethod
     def with_turn(

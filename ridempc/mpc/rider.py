@@ -11,7 +11,11 @@ Every 2 ms (500 Hz) the rider
    and solves the linear MPC
    (:class:`~ridempc.mpc.controller.LinearMpc`) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
-   trajectory, then rides on steadily; a commanded deck roll replaces the reference's roll;
+   trajectory, then rides on steadily (on the skateboard, which only a push drives, it
+   coasts: the steady ride is slowed to the board's speed,
+   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`); a commanded deck roll
+   replaces the reference's roll, and on the skateboard turns the reference's heading at
+   the rate the roll steers (eq. 14);
    on the Hovershoes the MPC also sees where each foot stands along its shoe and each
    shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
    :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz;
@@ -52,6 +56,7 @@ from numpy.typing import NDArray
 from ridempc.boards.board import Board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.skateboard.parameters import SkateboardParameters
+from ridempc.boards.skateboard.reduced import yaw_rate
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -171,7 +176,11 @@ class MpcRider(Controller):
         # The MPC's forces weigh ``wbc_force_weight`` (100 by default, 100x the WBC's own
         # default): their distribution over the feet is what rolls a deck or a platform, and
         # the CoM and orientation tasks leave it free (the dog's roll-tracking: roll RMSE
-        # 0.063 rad at 1, 0.048 at 100).
+        # 0.063 rad at 1, 0.048 at 100). The dog's is 800: at 100 its WBC unloaded the
+        # three-leg stance's light foot that the MPC keeps at 0.4 of its share, and the
+        # foot lifted off the deck (push-offs, seeds 0 and 1: 2 of 8 stayed up; at 800 all
+        # but the two 1.0 m/s ones, whose roll phase at speed fell; roll-tracking's RMSE
+        # 0.0150 rad at 100, 0.0196 at 800, 0.0207 at 1000).
         sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
         settings_wbc = WbcSettings(
             springs="rigid" if sprung else "passive",
@@ -193,6 +202,11 @@ class MpcRider(Controller):
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
         self.shoes = self._shoe_observer(loaded)
+        self._steer_gain = (
+            skateboard_model(loaded).reduced.steer_gain
+            if loaded is not None and isinstance(loaded.params, SkateboardParameters)
+            else None
+        )
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -322,13 +336,16 @@ class MpcRider(Controller):
             self.manoeuvre = replace(wanted, start=start)
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
-        turn = self._yaw_rate_horizon(command, now)
+        names, roll = self.layout.names, self._roll_horizon(command, now)
+        turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         mapped = self._mapped(estimate)
-        self._follow_board(mapped, t_ref, turn, now)
+        coasting = self._coasting(t_ref)
+        self._follow_board(mapped, t_ref, turn, now, coasting)
         x0 = self.map.state(mapped)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
-        names, roll = self.layout.names, self._roll_horizon(command, now, problem)
+        if coasting:
+            problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
@@ -354,18 +371,28 @@ class MpcRider(Controller):
             mpc_iterations=float(plan.iterations),
         )
 
+    def _coasting(self, t_ref: float) -> bool:
+        """Whether the rider coasts (:meth:`ManoeuvreSelector.coasting`): past the end of
+        an ``accelerate`` on a board it drives only by pushing off."""
+        return (
+            self.selector.coasts
+            and self.manoeuvre.kind == "accelerate"
+            and t_ref >= float(self.mpc.reference.times[-1])
+        )
+
     def _follow_board(
-        self, estimate: EstimatedState, t_ref: float, turn: Array, now: float
+        self, estimate: EstimatedState, t_ref: float, turn: Array, now: float, coasting: bool
     ) -> None:
         """Integrate the commanded turn and move the library frame onto the board: across
-        the reference's line (turned by the turn so far), and along it too while turning."""
+        the reference's line (turned by the turn so far), and along it too while turning
+        or coasting (the reference's steady ride is not where a coasting board goes)."""
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])
         x, y, heading = self.layout.board_pose(self.mpc.reference.states_at(np.array([t_ref]))[0])
-        turning = bool(np.any(turn)) or self._turned != 0.0
+        along = coasting or bool(np.any(turn)) or self._turned != 0.0
         self.map.follow_sideways(
-            estimate, (x, y, heading + self._turned), along=turning, heading=self._follows_heading
+            estimate, (x, y, heading + self._turned), along=along, heading=self._follows_heading
         )
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
@@ -385,13 +412,13 @@ class MpcRider(Controller):
         swinging = [f for f, c in zip(feet, support, strict=True) if c is Contact.SWING]
         self.estimator.set_support(ground, swinging)
 
-    def _roll_horizon(self, command: Command, now: float, problem: MpcProblem) -> Array:
+    def _roll_horizon(self, command: Command, now: float) -> Array:
         """The commanded deck roll at the horizon's nodes [rad]: read ahead from the
         ``command_preview`` when the ride's commands are planned, else the present command
         extrapolated at its rate (a backward difference over the last MPC step), which
         tracks a moving command one step late."""
-        nodes = problem.state_reference.shape[0]
-        times = now + problem.dt * np.arange(nodes)
+        settings = self.mpc.settings
+        times = now + settings.dt * np.arange(settings.horizon + 1)
         planned = self._planned("roll", times)
         if planned is not None:
             return planned
@@ -401,6 +428,18 @@ class MpcRider(Controller):
         if previous is not None and now > previous[0]:
             rate = (command.roll - previous[1]) / (now - previous[0])
         return np.asarray(command.roll + rate * (times - now), dtype=float)
+
+    def _roll_turn(self, roll: Array, speed: float) -> Array:
+        """The turn a commanded deck roll steers, over the horizon's steps [rad/s]: on the
+        skateboard eq. (14), :math:`\\omega_k = -v \\sin\\varphi^*_k / K_{board}` at the
+        board's speed :math:`v` (the deck's roll is how it steers); zero elsewhere or
+        without a roll command. Held on the reference's heading instead, a rolled deck
+        rolling at 0.5 m/s fought the heading, reached half its commanded roll and then
+        twice it the other way (push-off-1.0 fell at 10.7 s in its roll phase)."""
+        steps = self.mpc.settings.horizon
+        if self._steer_gain is None or not self.selector.commands_roll(self.layout.names, roll):
+            return np.zeros(steps)
+        return np.asarray(yaw_rate(speed, roll[:steps], self._steer_gain), dtype=float)
 
     def _yaw_rate_horizon(self, command: Command, now: float) -> Array:
         """The commanded yaw rate over the horizon's steps [rad/s], read ahead from the
