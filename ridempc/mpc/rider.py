@@ -178,9 +178,10 @@ class MpcRider(Controller):
         # the CoM and orientation tasks leave it free (the dog's roll-tracking: roll RMSE
         # 0.063 rad at 1, 0.048 at 100). The dog's is 800: at 100 its WBC unloaded the
         # three-leg stance's light foot that the MPC keeps at 0.4 of its share, and the
-        # foot lifted off the deck (push-offs, seeds 0 and 1: 2 of 8 stayed up; at 800 all
-        # but the two 1.0 m/s ones, whose roll phase at speed fell; roll-tracking's RMSE
-        # 0.0150 rad at 100, 0.0196 at 800, 0.0207 at 1000).
+        # foot lifted off the deck (push-offs, seeds 0 and 1: 2 of 8 stayed up at 100, 4 at
+        # 300, 6 at 600 and 800, 5 at 1000, none at 10000, all with coasting; 7 at 800 with
+        # the roll's turn too; roll-tracking's RMSE 0.0150 rad at 100, 0.0149 at 300, 0.0181
+        # at 600, 0.0196 at 800, 0.0207 at 1000).
         sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
         settings_wbc = WbcSettings(
             springs="rigid" if sprung else "passive",
