@@ -296,6 +296,24 @@ def test_the_frame_follows_the_board_sideways_only(dog) -> None:
     assert after[n["board_yaw"]] == pytest.approx(before[n["board_yaw"]])
 
 
+def test_the_rider_speed_is_the_centre_of_mass_along_the_board(dog) -> None:
+    """``rider_speed``, on which the MPC chooses and phases its manoeuvres, is the centre of
+    mass's velocity along the board's heading, whatever the speed the feet read off the
+    board (on the Segway it swung +-0.3 m/s about the rider's at 3-4 m/s)."""
+    _, rider = _ride(dog, 0.1)
+    estimate = rider.estimator.state
+    assert estimate is not None and estimate.boards
+    world = np.array([0.4, 0.1, 0.0])  # [m/s]
+    v = np.zeros_like(estimate.v)
+    v[:3] = estimate.rotation.T @ world  # the base translating, joints still: CoM's velocity
+    board = estimate.boards[0]
+    heading = np.array([np.cos(board.yaw), np.sin(board.yaw), 0.0])
+    for board_speed in (0.0, 0.7):
+        moved = replace(board, velocity=board_speed * heading)
+        still = replace(estimate, v=v, boards=(moved, *estimate.boards[1:]))
+        assert rider.map.rider_speed(still) == pytest.approx(world @ heading, abs=1e-12)
+
+
 def test_turns_are_laid_over_the_boards_the_rider_can_turn() -> None:
     """A Hovershoe turns under the feet's yaw torque; the Segway only by its knee bar, which
     the rider does not push (pinned), so a yaw-rate command is not laid over its reference,

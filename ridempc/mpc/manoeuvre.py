@@ -7,7 +7,8 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   (standing on the board at rest) is held: the reference time stays before its start;
 - **accelerate** to the commanded speed :math:`v^*` [m/s] (the nearest entry, or a blend of
   the two neighbouring ones where the library allows it), started *at the phase where the
-  reference's speed equals the board's estimated speed*, so a step from 0.5 to 1.0 m/s picks
+  reference's speed equals the rider's estimated speed* (its centre of mass's, along the
+  board's heading, as the reference's ``vx`` is), so a step from 0.5 to 1.0 m/s picks
   up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily
   (where the library has no ``stop``, the skateboard, which only a push drives, it
   **coasts**: the steady ride slowed to the board's speed, :meth:`ManoeuvreSelector.coasting`);
@@ -17,9 +18,9 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   starts at the entry's end, riding steadily at it;
 - **stop** when the command returns to zero, where the library has ``stop`` entries (the
   skateboard has none: it coasts on, four-leg balancing); also to **slow down** while the
-  board is more than ``RETARGET_BAND`` faster than a commanded speed that is not rest: the
-  stop from the board's speed, started at its phase, brakes as the library found feasible,
-  and once the board is down to the command the ``accelerate`` entry of that speed rides
+  rider is more than ``RETARGET_BAND`` faster than a commanded speed that is not rest: the
+  stop from the rider's speed, started at its phase, brakes as the library found feasible,
+  and once the rider is down to the command the ``accelerate`` entry of that speed rides
   on at it (started at its end). A speed reference stepped down instead (0.25 m/s at a
   time, as a ramp retargets) braked the Segway from 4 m/s into a fall.
 
@@ -169,7 +170,7 @@ class ManoeuvreSelector:
         return float(min(max(target, targets[0]), targets[-1]))
 
     def select(self, command: Command, current: Manoeuvre, now: float, speed: float) -> Manoeuvre:
-        """The manoeuvre for ``command`` at ``now`` [s], the board at ``speed`` [m/s].
+        """The manoeuvre for ``command`` at ``now`` [s], the rider at ``speed`` [m/s].
 
         A new manoeuvre's ``start`` is provisional (``now``); the rider moves it to match
         the reference's speed phase (:meth:`phase_start`).
@@ -197,7 +198,7 @@ class ManoeuvreSelector:
         """The start time that puts ``now`` at the reference's first time where its speed
         reaches ``speed`` (rising for ``accelerate``, falling for ``stop``).
 
-        A board already faster than the whole ``accelerate`` reference (a slow-down to a
+        A rider already faster than the whole ``accelerate`` reference (a slow-down to a
         lower speed that is not rest) starts at the reference's end, riding steadily at
         its target: the MPC brakes to it. Started from rest instead, the reference asked a
         rider at 4 m/s for 0 m/s at once (the Segway's stop from 4 m/s fell in 0.3 s).

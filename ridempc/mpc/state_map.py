@@ -240,6 +240,18 @@ class StateMap:
                 x[i] = self._board_value(str(key), estimate.boards, estimate.time)
         return x
 
+    def rider_speed(self, estimate: EstimatedState) -> float:
+        """The centre of mass's speed along platform 0's heading (the base's heading without
+        a board) [m/s]: :math:`\\dot c_{CoM} \\cdot (\\cos\\psi, \\sin\\psi)`."""
+        pin.centerOfMass(self.robot.model, self.data, estimate.q, estimate.v)
+        velocity = self.data.vcom[0]
+        if estimate.boards:
+            yaw = estimate.boards[0].yaw
+        else:
+            rotation = estimate.rotation
+            yaw = math.atan2(float(rotation[1, 0]), float(rotation[0, 0]))
+        return float(velocity[0] * math.cos(yaw) + velocity[1] * math.sin(yaw))
+
     def anchor(self, estimate: EstimatedState, board_pose: tuple[float, float, float]) -> None:
         """Set the frame so that platform 0's estimate lands on ``board_pose`` (x, y, yaw) of
         the reference."""
