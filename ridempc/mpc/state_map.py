@@ -58,10 +58,16 @@ HEADING_SPEED: float = 0.5  # [m/s] below this a board's direction of travel is 
 HEADING_FILTER_S: float = 0.3  # [s] time constant of the followed heading
 
 
+def _along(velocity: Array, yaw: float) -> float:
+    """A velocity's component along the heading ``yaw`` [rad]:
+    :math:`v \\cdot (\\cos\\psi, \\sin\\psi)` [m/s]."""
+    return float(velocity[0] * math.cos(yaw) + velocity[1] * math.sin(yaw))
+
+
 def forward_speed(board: BoardEstimate) -> float:
     """The platform's speed along its heading, :math:`\\dot c \\cdot (\\cos\\psi, \\sin\\psi)`
     [m/s]."""
-    return float(board.velocity[0] * math.cos(board.yaw) + board.velocity[1] * math.sin(board.yaw))
+    return _along(board.velocity, board.yaw)
 
 
 def _wrap(angle: float) -> float:
@@ -244,22 +250,15 @@ class StateMap:
         """The centre of mass's speed along platform 0's heading (the base's heading without
         a board) [m/s]: :math:`\\dot c_{CoM} \\cdot (\\cos\\psi, \\sin\\psi)`."""
         pin.centerOfMass(self.robot.model, self.data, estimate.q, estimate.v)
-        velocity = self.data.vcom[0]
-        if estimate.boards:
-            yaw = estimate.boards[0].yaw
-        else:
-            rotation = estimate.rotation
-            yaw = math.atan2(float(rotation[1, 0]), float(rotation[0, 0]))
-        return float(velocity[0] * math.cos(yaw) + velocity[1] * math.sin(yaw))
+        yaw = estimate.boards[0].yaw if estimate.boards else estimate.yaw
+        return _along(self.data.vcom[0], yaw)
 
     def anchor(self, estimate: EstimatedState, board_pose: tuple[float, float, float]) -> None:
         """Set the frame so that platform 0's estimate lands on ``board_pose`` (x, y, yaw) of
         the reference."""
         board = estimate.boards[0] if estimate.boards else None
         if board is None:
-            rotation = estimate.rotation
-            yaw_world = math.atan2(float(rotation[1, 0]), float(rotation[0, 0]))
-            position = estimate.base_position
+            yaw_world, position = estimate.yaw, estimate.base_position
         else:
             yaw_world, position = board.yaw, board.position
         x_ref, y_ref, yaw_ref = board_pose
