@@ -13,7 +13,7 @@ from ridempc.boards import load_board
 from ridempc.cli import main
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.rider import WBC_GRACE_TICKS, MpcRider
-from ridempc.mpc.state_map import HEADING_FILTER_S
+from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -294,6 +294,29 @@ def test_the_frame_follows_the_board_sideways_only(dog) -> None:
         gap_before = before[n[f"com_{axis}"]] - before[n[f"board_{axis}"]]
         assert after[n[f"com_{axis}"]] - after[n[f"board_{axis}"]] == pytest.approx(gap_before)
     assert after[n["board_yaw"]] == pytest.approx(before[n["board_yaw"]])
+
+
+@pytest.mark.parametrize("ahead", [0.05, 0.5, -0.5])
+def test_the_frame_keeps_the_board_within_the_slack_along_the_line(dog, ahead) -> None:
+    """Along the reference's line the board keeps its offset up to ``ALONG_SLACK`` and no
+    more (a rider 1 m behind her reference at 0.5 m/s on the Hovershoes was planned to slow
+    down); across it, it is put on the line."""
+    _, rider = _ride(dog, 0.1)
+    estimate = rider.estimator.state
+    assert estimate is not None
+    n, state_map = rider.layout.names, rider.map
+    before = state_map.state(estimate)
+    board = np.array([before[n["board_x"]], before[n["board_y"]]])
+    yaw = 0.3
+    normal, along = np.array([-np.sin(yaw), np.cos(yaw)]), np.array([np.cos(yaw), np.sin(yaw)])
+    line = board + 0.2 * normal + ahead * along  # the reference's place, ahead and across
+    state_map.follow_sideways(estimate, (line[0], line[1], yaw))
+    after = state_map.state(estimate)
+    moved = np.array([after[n["board_x"]], after[n["board_y"]]]) - line
+    assert normal @ moved == pytest.approx(0.0, abs=1e-12)
+    kept = float(np.clip(-ahead, -ALONG_SLACK, ALONG_SLACK))
+    assert along @ moved == pytest.approx(kept, abs=1e-12)
+    assert abs(along @ moved) <= ALONG_SLACK + 1e-12
 
 
 def test_the_rider_speed_is_the_centre_of_mass_along_the_board(dog) -> None:

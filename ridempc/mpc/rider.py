@@ -390,8 +390,9 @@ class MpcRider(Controller):
         self, estimate: EstimatedState, t_ref: float, turn: Array, now: float, coasting: bool
     ) -> None:
         """Integrate the commanded turn and move the library frame onto the board: across
-        the reference's line (turned by the turn so far), and along it too while turning
-        or coasting (the reference's steady ride is not where a coasting board goes)."""
+        the reference's line (turned by the turn so far), along it by what lies beyond
+        :data:`~ridempc.mpc.state_map.ALONG_SLACK`, and all along it while turning or
+        coasting (the reference's steady ride is not where a coasting board goes)."""
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])
