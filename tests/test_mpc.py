@@ -503,8 +503,11 @@ def test_a_commanded_roll_moves_the_reference_to_a_balance(skate_mpc: LinearMpc)
 
 def test_a_commanded_turn_lays_an_arc_over_the_reference() -> None:
     """``with_turn``: no rate leaves the problem as it is; 0.5 rad/s turns every heading by
-    0.5 k dt, adds the rate to the yaw rates, and turns the velocity and the position
-    steps with it (speeds and step lengths kept)."""
+    0.5 k dt, adds the rate to the yaw rates, turns the centre of mass's velocity and path
+    steps with it (speeds and step lengths kept), and turns rider and shoes as one body:
+    the left shoe (the frame's anchor) stays at node 0, each shoe's offset from the centre
+    of mass turns with the heading, and the outer shoe rolls faster by the rate times
+    their spacing."""
     mpc = LinearMpc.from_library("cassie", "hovershoes", "accelerate", 1.0)
     layout = StateLayout.from_names(mpc.reference.state_names)
     n = layout.names
@@ -522,14 +525,28 @@ def test_a_commanded_turn_lays_an_arc_over_the_reference() -> None:
     np.testing.assert_allclose(speed, np.hypot(before[:, n["vx"]], before[:, n["vy"]]))
     heading = np.arctan2(after[:, n["vy"]], after[:, n["vx"]])
     np.testing.assert_allclose(heading, angle, atol=1e-6)  # riding straight along x before
-    for prefix in ("com_", "left_"):
-        xy = after[:, [n[f"{prefix}x"], n[f"{prefix}y"]]]
-        lengths = np.linalg.norm(np.diff(xy, axis=0), axis=1)
-        original = np.linalg.norm(
-            np.diff(before[:, [n[f"{prefix}x"], n[f"{prefix}y"]]], axis=0), axis=1
+
+    def xy(states: np.ndarray, prefix: str) -> np.ndarray:
+        return states[:, [n[f"{prefix}x"], n[f"{prefix}y"]]]
+
+    lengths = np.linalg.norm(np.diff(xy(after, "com_"), axis=0), axis=1)
+    original = np.linalg.norm(np.diff(xy(before, "com_"), axis=0), axis=1)
+    np.testing.assert_allclose(lengths, original, atol=1e-12)
+    np.testing.assert_allclose(xy(after, "left_")[0], xy(before, "left_")[0], atol=1e-12)
+    cos, sin = np.cos(angle), np.sin(angle)
+    for prefix in ("left_", "right_"):
+        offset = xy(before, prefix) - xy(before, "com_")
+        turned_offset = np.column_stack(
+            [cos * offset[:, 0] - sin * offset[:, 1], sin * offset[:, 0] + cos * offset[:, 1]]
         )
-        np.testing.assert_allclose(lengths, original, atol=1e-12)
-        np.testing.assert_allclose(xy[0], before[0, [n[f"{prefix}x"], n[f"{prefix}y"]]])
+        np.testing.assert_allclose(xy(after, prefix) - xy(after, "com_"), turned_offset, atol=1e-12)
+    spacing = before[:, n["left_y"]] - before[:, n["right_y"]]
+    assert spacing.min() > 0.3  # [m] the shoes side by side
+    np.testing.assert_allclose(
+        after[:, n["right_v"]] - after[:, n["left_v"]],
+        before[:, n["right_v"]] - before[:, n["left_v"]] + 0.5 * spacing,
+        atol=1e-9,
+    )
 
 
 def test_a_coasting_rider_slows_the_steady_ride_to_the_board(skate_mpc: LinearMpc) -> None:

@@ -319,6 +319,26 @@ def test_the_frame_keeps_the_board_within_the_slack_along_the_line(dog, ahead) -
     assert abs(along @ moved) <= ALONG_SLACK + 1e-12
 
 
+def test_headings_are_unwrapped_to_the_turn_so_far(dog) -> None:
+    """Past half a turn the commanded heading is beyond pi while the estimate's wraps: the
+    MPC's state carries each heading within pi of the reference's turned by the turn so
+    far, and leaves the other states alone."""
+    _, rider = _ride(dog, 0.1)
+    estimate = rider.estimator.state
+    assert estimate is not None
+    names = rider.layout.names
+    headings = [i for n, i in names.items() if n.endswith(("_yaw", "_psi"))]
+    assert headings
+    reference = rider.mpc.reference.states_at(np.array([0.0]))[0]
+    rider._turned = 3.0  # [rad] turned so far
+    x0 = rider.map.state(estimate)
+    x0[headings] = reference[headings] + 3.1 - 2.0 * np.pi  # as the estimate wraps it
+    out = rider._unwrapped(x0, 0.0)
+    np.testing.assert_allclose(out[headings], reference[headings] + 3.1, atol=1e-12)
+    others = [i for i in range(len(x0)) if i not in headings]
+    np.testing.assert_array_equal(out[others], x0[others])
+
+
 def test_the_rider_speed_is_the_centre_of_mass_along_the_board(dog) -> None:
     """``rider_speed``, on which the MPC chooses and phases its manoeuvres, is the centre of
     mass's velocity along the board's heading, whatever the speed the feet read off the

@@ -251,17 +251,26 @@ class ManoeuvreSelector:
         problem: MpcProblem, layout: StateLayout, rates: Array, turned: float = 0.0
     ) -> MpcProblem:
         """The problem's reference turned at the commanded yaw rates :math:`\\omega^*_k`
-        [rad/s] over the horizon's steps (unchanged when all are zero).
+        [rad/s] over the horizon's steps (unchanged when all are zero and nothing is
+        turned yet), the rider and her platforms turning as one body.
 
-        With :math:`\\Delta\\psi_k = \\sum_{j<k} \\omega^*_j \\Delta t` the heading
-        turned by node :math:`k`, every heading (the platforms' and the base's yaw) gains
-        :math:`\\Delta\\psi_k`, every yaw rate (the platforms' and the base's
-        :math:`\\omega_z`, level base) gains :math:`\\omega^*_k`, and the horizontal
-        velocity and the steps of every horizontal position (the centre of mass's, each
-        platform's) are turned by :math:`R_z(\\Delta\\psi_k)` about node 0: the reference
-        rides the arc the command asks for. ``turned`` [rad] is the turn commanded so far
-        (the rider integrates the command), added to every node: the heading is tracked,
-        and a turn once made is kept when the command ends.
+        With :math:`\\Delta\\psi_k = \\psi_0 + \\sum_{j<k} \\omega^*_j \\Delta t` the heading
+        turned by node :math:`k` (``turned`` [rad], :math:`\\psi_0`, is the turn commanded
+        so far, which the rider integrates: the heading is tracked, and a turn once made
+        is kept when the command ends), every heading (the platforms' and the base's yaw)
+        gains :math:`\\Delta\\psi_k` and every yaw rate (the platforms' and the base's
+        :math:`\\omega_z`, level base) gains :math:`\\omega^*_k`. The centre of mass rides
+        the arc: its velocity and the steps of its path are turned by
+        :math:`R_k = R_z(\\Delta\\psi_k)`, from its node-0 place turned by :math:`\\psi_0`
+        about platform 0's (where the library frame puts the board). Each platform keeps
+        its place in the rider's frame, :math:`p_{i,k} = c_k + R_k (\\bar p_{i,k} - \\bar c_k)`
+        (bars: the reference's), so that two Hovershoes stay side by side as they turn
+        (their headings turned while their offsets were not: after half a radian the
+        reference put the outer shoe 0.2 m behind its place beside the inner), and its
+        speed is its point's on a body turning at :math:`\\omega^*_k`,
+        :math:`v_{i,k} = \\bar v_{i,k} - \\omega^*_k\\, l_{i,k}`, with :math:`l_{i,k}` [m]
+        its offset to the left of the centre of mass across its heading (the inner shoe
+        rolls slower).
         """
         rates = np.asarray(rates, dtype=float)
         if not np.any(rates) and turned == 0.0:
@@ -272,15 +281,31 @@ class ManoeuvreSelector:
         turned_k = turned + np.concatenate([[0.0], ahead])
         step_rates = np.concatenate([rates[: states.shape[0] - 1], rates[-1:]])[: len(turned_k)]
         cos, sin = np.cos(turned_k), np.sin(turned_k)
-        for prefix in ("com_", *layout.prefixes):
-            ix, iy = names[f"{prefix}x"], names[f"{prefix}y"]
-            steps = np.diff(states[:, [ix, iy]], axis=0)
-            c, s = cos[:-1], sin[:-1]
-            rotated = np.column_stack(
-                [c * steps[:, 0] - s * steps[:, 1], s * steps[:, 0] + c * steps[:, 1]]
+
+        def turn(xy: Array) -> Array:
+            """Row :math:`k` turned by :math:`R_k`."""
+            c, s = cos[: len(xy)], sin[: len(xy)]
+            return np.column_stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]])
+
+        com = [names["com_x"], names["com_y"]]
+        pivot = states[0, [names[f"{layout.prefixes[0]}x"], names[f"{layout.prefixes[0]}y"]]]
+        centre = states[:, com]
+        start = pivot + turn(centre[:1] - pivot)[0]
+        steps = turn(np.diff(centre, axis=0))
+        turned_centre = start + np.vstack([np.zeros(2), np.cumsum(steps, axis=0)])
+        for prefix in layout.prefixes:
+            columns = [names[f"{prefix}x"], names[f"{prefix}y"]]
+            offset = states[:, columns] - centre
+            heading = next(
+                (states[:, names[prefix + h]] for h in ("psi", "yaw") if prefix + h in names),
+                np.zeros(len(states)),
             )
-            states[1:, ix] = states[0, ix] + np.cumsum(rotated[:, 0])
-            states[1:, iy] = states[0, iy] + np.cumsum(rotated[:, 1])
+            left = np.cos(heading) * offset[:, 1] - np.sin(heading) * offset[:, 0]
+            for speed in ("v", "speed"):
+                if prefix + speed in names:
+                    states[:, names[prefix + speed]] -= step_rates * left
+            states[:, columns] = turned_centre + turn(offset)
+        states[:, com] = turned_centre
         vx, vy = states[:, names["vx"]].copy(), states[:, names["vy"]].copy()
         states[:, names["vx"]] = cos * vx - sin * vy
         states[:, names["vy"]] = sin * vx + cos * vy

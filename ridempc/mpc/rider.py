@@ -46,6 +46,7 @@ from then on, and its ``summary()`` says why and when.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 from typing import Any
@@ -347,7 +348,7 @@ class MpcRider(Controller):
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         self._follow_board(mapped, t_ref, turn, now, coasting)
-        x0 = self.map.state(mapped)
+        x0 = self._unwrapped(self.map.state(mapped), t_ref)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
         if coasting:
@@ -376,6 +377,18 @@ class MpcRider(Controller):
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
+
+    def _unwrapped(self, x0: Array, t_ref: float) -> Array:
+        """``x0`` with each heading (``*_yaw``, ``*_psi``) [rad] within :math:`\\pi` of the
+        reference's turned by the turn so far: the estimate's angles wrap at
+        :math:`\\pm\\pi`, the commanded turn does not."""
+        reference = self.mpc.reference.states_at(np.array([t_ref]))[0]
+        out = x0.copy()
+        for name, i in self.layout.names.items():
+            if name.endswith(("_yaw", "_psi")):
+                target = reference[i] + self._turned
+                out[i] = target + math.remainder(x0[i] - target, 2.0 * math.pi)
+        return out
 
     def _coasting(self, t_ref: float) -> bool:
         """Whether the rider coasts (:meth:`ManoeuvreSelector.coasting`): past the end of
