@@ -333,7 +333,7 @@ def test_headings_are_unwrapped_to_the_turn_so_far(dog) -> None:
     rider._turned = 3.0  # [rad] turned so far
     x0 = rider.map.state(estimate)
     x0[headings] = reference[headings] + 3.1 - 2.0 * np.pi  # as the estimate wraps it
-    out = rider._unwrapped(x0, 0.0)
+    out = rider._unwrapped(x0, reference)
     np.testing.assert_allclose(out[headings], reference[headings] + 3.1, atol=1e-12)
     others = [i for i in range(len(x0)) if i not in headings]
     np.testing.assert_array_equal(out[others], x0[others])

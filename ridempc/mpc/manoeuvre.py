@@ -51,6 +51,7 @@ __all__ = [
     "HOLD",
     "MOVING",
     "RETARGET_BAND",
+    "HEADING_SUFFIXES",
     "YAW_RATE_SUFFIXES",
     "Manoeuvre",
     "ManoeuvreSelector",
@@ -67,6 +68,7 @@ HOLD: str = "hold"
 RETARGET_BAND: float = 0.25
 # Name endings of a board platform's yaw-rate states (the Hovershoes' and the Segway's).
 YAW_RATE_SUFFIXES: tuple[str, ...] = ("_psi_dot", "_yaw_rate")
+HEADING_SUFFIXES: tuple[str, ...] = ("_yaw", "_psi")  # the base's and the platforms' headings
 
 
 @dataclass(frozen=True)
@@ -128,10 +130,14 @@ class StateLayout:
         """Indices of the states that are not a platform's (the rider's)."""
         return tuple(i for n, i in self.names.items() if not n.startswith(self.prefixes))
 
+    def heading(self, prefix: str) -> int | None:
+        """The index of a platform's heading state (``<prefix>yaw`` or ``<prefix>psi``)."""
+        return self.names.get(f"{prefix}yaw", self.names.get(f"{prefix}psi"))
+
     def board_pose(self, state: Array) -> tuple[float, float, float]:
         """The first platform's (x, y, heading) in a state."""
         prefix, names = self.prefixes[0], self.names
-        heading = names.get(f"{prefix}yaw", names.get(f"{prefix}psi"))
+        heading = self.heading(prefix)
         if heading is None:
             raise ConfigError(f"no heading state for platform '{prefix}'")
         x, y = state[names[f"{prefix}x"]], state[names[f"{prefix}y"]]
@@ -296,21 +302,18 @@ class ManoeuvreSelector:
         for prefix in layout.prefixes:
             columns = [names[f"{prefix}x"], names[f"{prefix}y"]]
             offset = states[:, columns] - centre
-            heading = next(
-                (states[:, names[prefix + h]] for h in ("psi", "yaw") if prefix + h in names),
-                np.zeros(len(states)),
-            )
+            index = layout.heading(prefix)
+            heading = np.zeros(len(states)) if index is None else states[:, index]
             left = np.cos(heading) * offset[:, 1] - np.sin(heading) * offset[:, 0]
             for speed in ("v", "speed"):
                 if prefix + speed in names:
                     states[:, names[prefix + speed]] -= step_rates * left
             states[:, columns] = turned_centre + turn(offset)
         states[:, com] = turned_centre
-        vx, vy = states[:, names["vx"]].copy(), states[:, names["vy"]].copy()
-        states[:, names["vx"]] = cos * vx - sin * vy
-        states[:, names["vy"]] = sin * vx + cos * vy
+        velocity = [names["vx"], names["vy"]]
+        states[:, velocity] = turn(states[:, velocity])
         for name, index in names.items():
-            if name.endswith(("_yaw", "_psi")):
+            if name.endswith(HEADING_SUFFIXES):
                 states[:, index] += turned_k
             elif name.endswith(YAW_RATE_SUFFIXES) or name == "wz":
                 states[:, index] += step_rates

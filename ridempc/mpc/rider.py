@@ -63,7 +63,13 @@ from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.manoeuvre import YAW_RATE_SUFFIXES, Manoeuvre, ManoeuvreSelector, StateLayout
+from ridempc.mpc.manoeuvre import (
+    HEADING_SUFFIXES,
+    YAW_RATE_SUFFIXES,
+    Manoeuvre,
+    ManoeuvreSelector,
+    StateLayout,
+)
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
@@ -347,8 +353,9 @@ class MpcRider(Controller):
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
-        self._follow_board(mapped, t_ref, turn, now, coasting)
-        x0 = self._unwrapped(self.map.state(mapped), t_ref)
+        here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
+        self._follow_board(mapped, here, turn, now, coasting)
+        x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
         problem = self.mpc.problem(t_ref, x0)
         if coasting:
@@ -378,14 +385,13 @@ class MpcRider(Controller):
             mpc_iterations=float(plan.iterations),
         )
 
-    def _unwrapped(self, x0: Array, t_ref: float) -> Array:
+    def _unwrapped(self, x0: Array, reference: Array) -> Array:
         """``x0`` with each heading (``*_yaw``, ``*_psi``) [rad] within :math:`\\pi` of the
-        reference's turned by the turn so far: the estimate's angles wrap at
+        ``reference`` state's turned by the turn so far: the estimate's angles wrap at
         :math:`\\pm\\pi`, the commanded turn does not."""
-        reference = self.mpc.reference.states_at(np.array([t_ref]))[0]
         out = x0.copy()
         for name, i in self.layout.names.items():
-            if name.endswith(("_yaw", "_psi")):
+            if name.endswith(HEADING_SUFFIXES):
                 target = reference[i] + self._turned
                 out[i] = target + math.remainder(x0[i] - target, 2.0 * math.pi)
         return out
@@ -400,16 +406,17 @@ class MpcRider(Controller):
         )
 
     def _follow_board(
-        self, estimate: EstimatedState, t_ref: float, turn: Array, now: float, coasting: bool
+        self, estimate: EstimatedState, reference: Array, turn: Array, now: float, coasting: bool
     ) -> None:
-        """Integrate the commanded turn and move the library frame onto the board: across
-        the reference's line (turned by the turn so far), along it by what lies beyond
-        :data:`~ridempc.mpc.state_map.ALONG_SLACK`, and all along it while turning or
-        coasting (the reference's steady ride is not where a coasting board goes)."""
+        """Integrate the commanded turn and move the library frame onto the board (the
+        ``reference`` state of this tick): across the reference's line (turned by the turn
+        so far), along it by what lies beyond :data:`~ridempc.mpc.state_map.ALONG_SLACK`,
+        and all along it while turning or coasting (the reference's steady ride is not
+        where a coasting board goes)."""
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])
-        x, y, heading = self.layout.board_pose(self.mpc.reference.states_at(np.array([t_ref]))[0])
+        x, y, heading = self.layout.board_pose(reference)
         along = coasting or bool(np.any(turn)) or self._turned != 0.0
         self.map.follow_sideways(
             estimate, (x, y, heading + self._turned), along=along, heading=self._follows_heading
