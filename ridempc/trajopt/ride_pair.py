@@ -9,7 +9,7 @@ resampled onto the new grid.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from functools import cache
 from typing import Any
 
@@ -50,19 +50,30 @@ def ride_models(robot_name: str, board_name: str) -> tuple[RiderModel, WheeledBo
     return rider, wheeled_board(board)
 
 
-def ride_options(overrides: dict[str, Any]) -> RideOptions:
-    """:class:`RideOptions` with ``overrides``; an unknown field is a ConfigError."""
+def ride_options(
+    overrides: Mapping[str, Any], defaults: Mapping[str, Any] | None = None
+) -> RideOptions:
+    """:class:`RideOptions` with the pair's ``defaults``, then ``overrides``; an unknown
+    field is a ConfigError."""
+    merged = {**(defaults or {}), **overrides}
     fields = {f.name for f in dataclasses.fields(RideOptions)}
-    unknown = sorted(set(overrides) - fields)
+    unknown = sorted(set(merged) - fields)
     if unknown:
         raise ConfigError(
             f"unknown ride option '{unknown[0]}' (valid: {', '.join(sorted(fields))})"
         )
-    return dataclasses.replace(RideOptions(), **overrides)
+    return dataclasses.replace(RideOptions(), **merged)
 
 
-def make_ride_pair(robot: str, board: str, default_targets: tuple[float, ...]) -> Pair:
-    """The :class:`Pair` of a biped ``robot`` on a wheeled ``board``."""
+def make_ride_pair(
+    robot: str,
+    board: str,
+    default_targets: tuple[float, ...],
+    options: Mapping[str, Any] | None = None,
+) -> Pair:
+    """The :class:`Pair` of a biped ``robot`` on a wheeled ``board``; ``options`` are the
+    pair's own :class:`RideOptions` defaults (an entry's options override them)."""
+    defaults = dict(options or {})
 
     def entries(targets: Sequence[float]) -> list[EntrySpec]:
         return [EntrySpec(kind, float(t)) for t in targets for kind in KINDS]
@@ -78,13 +89,13 @@ def make_ride_pair(robot: str, board: str, default_targets: tuple[float, ...]) -
                 f"target {spec.target:g} m/s is unreachable for {robot} on the {board}: its "
                 f"speed limit is {wheeled.speed_limit:g} m/s; targets must be in (0, that]"
             )
-        ride_options(spec.options)
+        ride_options(spec.options, defaults)
 
     def build(spec: EntrySpec) -> TrajectoryProblem:
         check(spec)
         rider, wheeled = ride_models(robot, board)
         return build_ride_problem(
-            rider, wheeled, spec.kind, spec.target, ride_options(spec.options), spec.name
+            rider, wheeled, spec.kind, spec.target, ride_options(spec.options, defaults), spec.name
         )
 
     def guess(problem: TrajectoryProblem, neighbour: Neighbour | None) -> Guess:

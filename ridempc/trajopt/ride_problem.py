@@ -69,6 +69,9 @@ class RideOptions:
         friction: Foot friction coefficient [-].
         settle: Steady riding before and after the manoeuvre [s].
         seconds_per_speed: Manoeuvre time per m/s of speed change [s / (m/s)].
+        manoeuvre_base: Manoeuvre time of a speed change on top of that [s]: the lean in
+            and out. A speed change of :math:`\\Delta v` takes
+            ``manoeuvre_base + seconds_per_speed`` :math:`\\Delta v`.
         turn_time: Duration of a turn [s].
         turn_angle: Heading change of a turn [rad].
         w_speed: Weight of the speed error.
@@ -90,6 +93,7 @@ class RideOptions:
     friction: float = 0.6
     settle: float = 0.5
     seconds_per_speed: float = 2.0
+    manoeuvre_base: float = 1.0
     turn_time: float = 3.0
     turn_angle: float = math.pi / 4
     w_speed: float = 10.0
@@ -166,7 +170,7 @@ def _initial_state(rider: RiderModel, board: WheeledBoard, speed: float) -> Arra
 
 
 def _duration(kind: str, target: float, o: RideOptions) -> float:
-    manoeuvre = o.turn_time if kind == "turn" else o.seconds_per_speed * target + 1.0
+    manoeuvre = o.turn_time if kind == "turn" else o.seconds_per_speed * target + o.manoeuvre_base
     steps = round((2 * o.settle + manoeuvre) / o.dt)
     return steps * o.dt
 
