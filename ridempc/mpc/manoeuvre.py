@@ -134,6 +134,10 @@ class StateLayout:
         """The index of a platform's heading state (``<prefix>yaw`` or ``<prefix>psi``)."""
         return self.names.get(f"{prefix}yaw", self.names.get(f"{prefix}psi"))
 
+    def speed(self, prefix: str) -> int | None:
+        """The index of a platform's speed state (``<prefix>v`` or ``<prefix>speed``)."""
+        return self.names.get(f"{prefix}v", self.names.get(f"{prefix}speed"))
+
     def board_pose(self, state: Array) -> tuple[float, float, float]:
         """The first platform's (x, y, heading) in a state."""
         prefix, names = self.prefixes[0], self.names
@@ -305,9 +309,9 @@ class ManoeuvreSelector:
             index = layout.heading(prefix)
             heading = np.zeros(len(states)) if index is None else states[:, index]
             left = np.cos(heading) * offset[:, 1] - np.sin(heading) * offset[:, 0]
-            for speed in ("v", "speed"):
-                if prefix + speed in names:
-                    states[:, names[prefix + speed]] -= step_rates * left
+            speed = layout.speed(prefix)
+            if speed is not None:
+                states[:, speed] -= step_rates * left
             states[:, columns] = turned_centre + turn(offset)
         states[:, com] = turned_centre
         velocity = [names["vx"], names["vy"]]

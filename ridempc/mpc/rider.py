@@ -210,6 +210,12 @@ class MpcRider(Controller):
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
         self.shoes = self._shoe_observer(loaded)
+        n = self.layout.names  # each shoe's (x, y, heading, speed) indices in the MPC's state
+        self._shoe_columns = (
+            tuple((n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes)
+            if self.shoes is not None
+            else ()
+        )
         self._steer_gain = (
             skateboard_model(loaded).reduced.steer_gain
             if loaded is not None and isinstance(loaded.params, SkateboardParameters)
@@ -248,14 +254,6 @@ class MpcRider(Controller):
         platform_of = {foot: k for k, group in enumerate(self.platform_feet) for foot in group}
         sites = [platform_of.get(names[f], -1) for f in self.wbc.model.site_foot]
         return ShoeObserver(shoes, sites)
-
-    @property
-    def _shoe_columns(self) -> tuple[tuple[int, int, int, int], ...]:
-        """Each platform's (x, y, heading, speed) indices in the MPC's state."""
-        n = self.layout.names
-        return tuple(
-            (n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes
-        )
 
     def _mapped(self, estimate: EstimatedState) -> EstimatedState:
         """The estimate as the MPC sees it: each Hovershoe's origin on its axis."""
