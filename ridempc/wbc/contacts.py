@@ -23,10 +23,9 @@ A site is *active* when its foot is planned in contact. It then stays on its sup
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -94,13 +93,30 @@ class ContactSet:
         return cls(np.asarray(active, dtype=bool), np.tile(_AXES, (n, 1, 1)), np.zeros((n, 3)))
 
 
-@functools.lru_cache(maxsize=64)
-def _sites_on(
-    site_foot: tuple[int, ...], foot_names: tuple[str, ...], feet: tuple[str, ...]
-) -> Index:
+_SITES_ON: dict[tuple[bytes, tuple[str, ...], tuple[str, ...]], Index] = {}
+_BLOCKS: dict[tuple[bytes, int], tuple[Index, Index]] = {}
+
+
+def _sites_on(site_foot: Index, foot_names: tuple[str, ...], feet: tuple[str, ...]) -> Index:
     """The sites of the feet named ``feet`` (a board's), layout order; few distinct calls."""
-    on = [i for i, name in enumerate(foot_names) if name in feet]
-    return np.flatnonzero(np.isin(site_foot, on))
+    key = (site_foot.tobytes(), foot_names, feet)
+    sites = _SITES_ON.get(key)
+    if sites is None:
+        on = [i for i, name in enumerate(foot_names) if name in feet]
+        sites = _SITES_ON[key] = np.flatnonzero(np.isin(site_foot, on))
+    return sites
+
+
+def _block_entries(sites: Index, n: int) -> tuple[Index, Index]:
+    """Flat indices, into a (n, 3, n, 3) coupling, of the blocks between ``sites``, in
+    (site, row, site, column) order, and of the 3 x 3 block's entry that each one takes."""
+    key = (sites.tobytes(), n)
+    entries = _BLOCKS.get(key)
+    if entries is None:
+        into = np.ravel_multi_index(np.ix_(sites, _XYZ, sites, _XYZ), (n, 3, n, 3)).ravel()
+        taken = np.tile(np.arange(9).reshape(3, 3), (sites.size, sites.size)).ravel()
+        entries = _BLOCKS[key] = (into, taken)
+    return entries
 
 
 def build_contact_set(
@@ -123,28 +139,30 @@ def build_contact_set(
         board_acceleration: Acceleration of each platform's origin [m/s^2] (zero if missing).
         platforms: Per board, how the rider's forces move it (None or missing: they do not).
     """
+    site_foot = np.asarray(site_foot)
+    names = tuple(foot_names)
     active = np.asarray(contact, dtype=bool)[site_foot]
-    contacts = ContactSet.on_ground(active)
+    n = len(site_foot)
+    frame = np.repeat(_AXES[None], n, axis=0)
+    acceleration = np.zeros((n, 3))
+    coupling: Array | None = None
     for k, board in enumerate(boards):
-        sites = _sites_on(tuple(int(f) for f in site_foot), tuple(foot_names), board.feet)
+        sites = _sites_on(site_foot, names, board.feet)
         if sites.size == 0:
             continue
-        contacts.frame[sites] = platform_rotation(board).T
-        origin_acceleration = (
-            np.asarray(board_acceleration[k]) if k < len(board_acceleration) else np.zeros(3)
-        )
+        frame[sites] = platform_rotation(board).T
         lever = terms.sites.position[sites] - board.position
         centripetal = -(board.yaw_rate**2) * lever  # omega x (omega x r), omega along z
         centripetal[:, 2] = 0.0
-        contacts.acceleration[sites] = origin_acceleration + centripetal
+        if k < len(board_acceleration):
+            centripetal += board_acceleration[k]
         platform = platforms[k] if k < len(platforms) else None
-        if platform is None:
-            continue
-        response = platform.response(board)
-        contacts.acceleration[sites] += response.drift
-        if contacts.coupling is None:
-            n = len(site_foot)
-            contacts = replace(contacts, coupling=np.zeros((n, 3, n, 3)))
-        assert contacts.coupling is not None
-        contacts.coupling[np.ix_(sites, _XYZ, sites, _XYZ)] = response.coupling[None, :, None, :]
-    return contacts
+        if platform is not None:
+            response = platform.response(board)
+            centripetal += response.drift
+            if coupling is None:
+                coupling = np.zeros((n, 3, n, 3))
+            into, taken = _block_entries(sites, n)
+            coupling.ravel()[into] = response.coupling.ravel()[taken]
+        acceleration[sites] = centripetal
+    return ContactSet(active, frame, acceleration, coupling)

@@ -78,5 +78,5 @@ class RollingPlatform:
         heading = np.array([math.cos(board.yaw), math.sin(board.yaw), 0.0])
         return PlatformResponse(
             drift=(self.drive * board.pitch / self.mass) * heading,
-            coupling=-np.outer(heading, heading) / self.mass,
+            coupling=-(heading[:, None] * heading[None, :]) / self.mass,
         )

@@ -280,18 +280,20 @@ class WholeBodyQP:
         else:
             solver = self._setup(problem)
         result = solver.solve(raise_error=False)
-        if warm and not self._accepted(result):
+        accepted = self._accepted(result)
+        if warm and not accepted:
             # A warm start (iterates and adapted rho of the last tick) can stall where a
             # cold one converges: Cassie on the Segway at 3.854 s ran out of 2000 iterations
             # warm and solved in 1050 cold. Retry once from scratch.
             self.cold_retries += 1
             solver = self._setup(problem)
             result = solver.solve(raise_error=False)
+            accepted = self._accepted(result)
         info = result.info
         x = np.array(result.x)
         status = str(info.status)
         polished = int(info.status_polish) == 1
-        if not self._accepted(result):
+        if not accepted:
             self._solver = None  # its iterates would warm-start the next tick from garbage
             return self._second_solver(problem, status, start)
         refined = False
@@ -376,7 +378,7 @@ class WholeBodyQP:
         1e-17 at some configurations)."""
         assert self._p is not None and self._a is not None
         for pattern, dense in ((self._p, problem.P), (self._a, problem.A)):
-            outside = dense.ravel()[pattern.outside]
+            outside = dense.ravel().take(pattern.outside)
             if outside.any():
                 largest = float(np.abs(dense).max())
                 if float(np.abs(outside).max()) > PATTERN_TOLERANCE * largest:

@@ -218,6 +218,7 @@ class ContactForceTask(Task):
         block = 3 * np.arange(n_sites)[:, None, None]
         self._block_rows = np.broadcast_to(block + np.arange(3)[:, None], (n_sites, 3, 3)).ravel()
         self._block_cols = np.broadcast_to(block + np.arange(3)[None, :], (n_sites, 3, 3)).ravel()
+        self._identity_blocks = np.tile(_EYE3.ravel(), n_sites)
         self._by_contacts: dict[bytes, tuple[Array, Array, Array]] = {}
 
     def _terms(self, standing: NDArray[np.bool_]) -> tuple[Array, Array, Array]:
@@ -239,15 +240,15 @@ class ContactForceTask(Task):
     ) -> tuple[Array, Array]:
         standing = np.asarray(targets.contact, dtype=bool)
         foot_hessian, foot_gradient, share = self._terms(standing)
-        normal = contacts.normal
-        tangential = _EYE3 - (1.0 - NORMAL_SHARE) * normal[:, :, None] * normal[:, None, :]
         weight = self._site_weight * standing[self._site_foot]
         site_hessian = np.zeros_like(foot_hessian)
-        site_hessian[self._block_rows, self._block_cols] = (
-            tangential * weight[:, None, None]
-        ).ravel()
         wanted = np.asarray(targets.forces, dtype=float).ravel()
         if targets.site_forces is None:
+            normal = contacts.normal
+            tangential = _EYE3 - (1.0 - NORMAL_SHARE) * normal[:, :, None] * normal[:, None, :]
+            site_hessian[self._block_rows, self._block_cols] = (
+                tangential * weight[:, None, None]
+            ).ravel()
             site_wanted = share @ wanted
         else:
             if targets.site_forces.shape != (len(self._site_foot), 3):
@@ -257,8 +258,8 @@ class ContactForceTask(Task):
                 )
             # the MPC's own site forces, normal part included, at the site weight (holding
             # them as strongly as the feet's totals felled Cassie on the Segway at 1.2 s)
-            site_hessian[self._block_rows, self._block_cols] = np.repeat(weight, 9) * np.tile(
-                _EYE3.ravel(), len(weight)
+            site_hessian[self._block_rows, self._block_cols] = (
+                np.repeat(weight, 9) * self._identity_blocks
             )
             site_wanted = targets.site_forces.ravel() * np.repeat(
                 standing[self._site_foot].astype(float), 3
