@@ -359,8 +359,9 @@ def test_the_rider_speed_is_the_centre_of_mass_along_the_board(dog) -> None:
 
 def test_turns_are_laid_over_the_boards_the_rider_can_turn() -> None:
     """A Hovershoe turns under the feet's yaw torque; the Segway only by its knee bar, which
-    the rider does not push (pinned), so a yaw-rate command is not laid over its reference,
-    and its library frame turns with the board's direction of travel instead."""
+    the plan does not push (pinned; the rider leans into it, ridempc.mpc.lean), so a
+    yaw-rate command is not laid over its reference, and its library frame turns with the
+    board's direction of travel instead."""
     cassie = load_robot("cassie")
     shoes, segway = MpcRider(cassie, "hovershoes"), MpcRider(cassie, "segway")
     assert shoes.steers and not shoes._follows_heading

@@ -15,7 +15,9 @@ Every 2 ms (500 Hz) the rider
    coasts: the steady ride is slowed to the board's speed,
    :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`); a commanded deck roll
    replaces the reference's roll, and on the skateboard turns the reference's heading at
-   the rate the roll steers (eq. 14);
+   the rate the roll steers (eq. 14); on the Segway, whose knee bar the plan cannot push,
+   the rider crouches into the robot's riding keyframe and leans into the bar: a yaw-rate
+   loop moves the reference's centre of mass sideways (:mod:`ridempc.mpc.lean`);
    on the Hovershoes the MPC also sees where each foot stands along its shoe and each
    shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
    :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz;
@@ -29,11 +31,12 @@ Every 2 ms (500 Hz) the rider
    swing target where the reference puts it, carried by the estimated board
    (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
    (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the reference's
-   joint angles where the library has them, the dog's, else the stance the rider starts
-   from on the board: held at the stance, the dog's trunk stayed 3-4 cm above the
-   reference's crouch before a push). A foot the schedule puts on the ground (a
-   push-off) stands on the ground for the WBC and the estimator, not on the board; a foot
-   it lifts is left out of the board's estimate even if it touches something;
+   joint angles where the library has them, the dog's, else the robot's riding posture
+   on the board, its stance unless a riding keyframe is given: held at the stance, the
+   dog's trunk stayed 3-4 cm above the reference's crouch before a push). A foot the
+   schedule puts on the ground (a push-off) stands on the ground for the WBC and the
+   estimator, not on the board; a foot it lifts is left out of the board's estimate even
+   if it touches something;
 4. sends the QP's torques as feedforward with its joint targets to the motor PD, at the
    robot's ``tracking_gain_scale`` of its default gains.
 
@@ -63,6 +66,7 @@ from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
     YAW_RATE_SUFFIXES,
@@ -96,8 +100,9 @@ __all__ = ["MpcRider", "platform_feet", "rolling_platforms"]
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
 # Board inputs of the library that this rider does not realise, held at zero in the MPC: the
-# Segway's knee bar (the rider stands clear of the pad; planning turns with a bar nobody
-# pushes let the yaw run off: stand-still fell at 1.5 s, pinned it stands).
+# Segway's knee bar (the legs' push on the pad is not in the model; planning turns with a bar
+# nobody pushes let the yaw run off: stand-still fell at 1.5 s, pinned it stands). The rider
+# leans into the bar instead (ridempc.mpc.lean).
 UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
@@ -173,6 +178,10 @@ class MpcRider(Controller):
         # frame turns with its heading (StateMap.follow_sideways).
         yaw_rates = any(n.endswith(YAW_RATE_SUFFIXES) for n in self.mpc.reference.state_names)
         self._follows_heading = yaw_rates and not self.steers
+        # A board turned by a bar the legs push (the Segway's knee bar, held at zero in the
+        # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
+        self.crouch = Crouch.of(robot, board)
+        self.lean = LeanSteering() if "knee_bar" in pinned and not self.steers else None
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_names(reference.state_names)
@@ -198,7 +207,7 @@ class MpcRider(Controller):
             robot,
             settings_wbc,
             pinocchio=self.pinocchio,
-            posture=motor_posture(self.pinocchio, robot, robot.stance_qpos(board)),
+            posture=motor_posture(self.pinocchio, robot, robot.ride_qpos(board)),
             platforms=rolling_platforms(loaded),
         )
         self._feedforward = robot.params.wbc_feedforward
@@ -363,6 +372,14 @@ class MpcRider(Controller):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
         problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
+        if self.crouch is not None:
+            problem = self.crouch.lower(problem, names["com_z"], now)
+        if self.lean is not None:
+            yaw_rate = float((estimate.rotation @ estimate.base_angular_velocity)[2])
+            if self.lean.update(now, command.yaw_rate, yaw_rate, speed) != 0.0:
+                balance = self.mpc.static_shift(t_ref, names["com_y"], self.layout.rider_states)
+                problem = self.lean.lean(problem, names["com_y"], balance)
+            self._diagnostics["lean_offset"] = self.lean.offset
         if self.shoes is not None:
             columns = self._shoe_columns
             states = self.shoes.shift_reference(problem.state_reference, columns)
