@@ -21,6 +21,19 @@ pushing foot carried :math:`(\\phi_x, \\phi_y) = (12.4, -12.4)` N on :math:`\\ph
 (in a variant of the library that keeps the pusher's knee bent; the committed one let go
 alike at 3.02 s), inside the outer pyramid of :math:`\\mu = 0.6` (0.50 of :math:`\\phi_z` each
 way) but on MuJoCo's diamond (0.996): the foot slid 6 cm and the dog fell within 0.5 s.
+
+The box is one of two inner pyramids with four faces; the other is the **diamond**
+
+.. math:: |\\phi_x| + |\\phi_y| \\le \\mu\\, \\phi_z,
+
+the box turned by 45 degrees: the same area, its corners on the cone along the tangent
+axes. It allows :math:`\\mu` rather than :math:`\\mu/\\sqrt2` along each axis, and half
+:math:`\\mu` each way on the diagonals, and with :math:`\\mu = 0.6` it lies inside MuJoCo's
+diamond of :math:`\\mu_{sim} = 1` however that one's tangents are turned (inside its
+inscribed circle, of radius 0.71). A line foot twists its platform with opposite forces
+across the line at its two ends, so its yaw torque grows by :math:`\\sqrt 2` in the
+diamond: with it the MPC rider holds a 0.5 rad/s turn on the Hovershoes, where in the box
+the shoes' yaw needed more than the feet could twist (:mod:`ridempc.mpc.pairs`).
 """
 
 from __future__ import annotations
@@ -31,7 +44,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["pyramid_matrix", "pyramid_rows", "pyramid_slope"]
+__all__ = ["SHAPES", "pyramid_matrix", "pyramid_rows", "pyramid_slope"]
+
+SHAPES: tuple[str, ...] = ("box", "diamond")
 
 
 def pyramid_slope(friction: float) -> float:
@@ -40,22 +55,39 @@ def pyramid_slope(friction: float) -> float:
     return friction / math.sqrt(2.0)
 
 
-def pyramid_rows(local: Any, friction: float) -> list[Any]:
-    """The inner pyramid's five rows on a force ``local`` = :math:`(\\phi_x, \\phi_y, \\phi_z)`
-    in its surface's frame (NumPy or CasADi), each :math:`\\ge 0` inside it:
-    :math:`\\phi_z,\\ s\\phi_z \\mp \\phi_x,\\ s\\phi_z \\mp \\phi_y`."""
-    s = pyramid_slope(friction)
-    return [
-        local[2],
-        s * local[2] - local[0],
-        s * local[2] + local[0],
-        s * local[2] - local[1],
-        s * local[2] + local[1],
-    ]
+def pyramid_rows(local: Any, friction: float, shape: str = "box") -> list[Any]:
+    """An inner pyramid's five rows on a force ``local`` = :math:`(\\phi_x, \\phi_y,
+    \\phi_z)` in its surface's frame (NumPy or CasADi), each :math:`\\ge 0` inside it:
+    the ``box`` :math:`\\phi_z,\\ s\\phi_z \\mp \\phi_x,\\ s\\phi_z \\mp \\phi_y`, or the
+    ``diamond`` :math:`\\phi_z,\\ \\mu\\phi_z \\mp \\phi_x \\mp \\phi_y` (in the order
+    ``--, -+, +-, ++``; see the module docstring).
+
+    Raises:
+        ValueError: An unknown shape.
+    """
+    if shape == "box":
+        s = pyramid_slope(friction)
+        return [
+            local[2],
+            s * local[2] - local[0],
+            s * local[2] + local[0],
+            s * local[2] - local[1],
+            s * local[2] + local[1],
+        ]
+    if shape == "diamond":
+        m = friction
+        return [
+            local[2],
+            m * local[2] - local[0] - local[1],
+            m * local[2] - local[0] + local[1],
+            m * local[2] + local[0] - local[1],
+            m * local[2] + local[0] + local[1],
+        ]
+    raise ValueError(f"friction pyramid shape '{shape}': expected one of {', '.join(SHAPES)}")
 
 
-def pyramid_matrix(friction: float) -> NDArray[np.float64]:
+def pyramid_matrix(friction: float, shape: str = "box") -> NDArray[np.float64]:
     """:func:`pyramid_rows` as a 5 x 3 matrix :math:`G`, :math:`G \\phi \\ge 0` inside the
     pyramid (the rows of the identity's columns): for controllers that apply it to many
     forces at once."""
-    return np.array(pyramid_rows(np.eye(3), friction))
+    return np.array(pyramid_rows(np.eye(3), friction, shape))

@@ -263,6 +263,7 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     rider = MpcRider(cassie, "hovershoes")
     np.testing.assert_allclose(rider.kp, 0.1 * np.array([m.kp for m in cassie.motors]))
     assert rider.wbc.settings.force_weight == pytest.approx(cassie.params.wbc_force_weight)
+    assert rider.wbc.settings.pyramid == rider.pair.pyramid == "diamond"
     scenario = resolve_scenario("stand-still", "hovershoes").with_duration(2.0)
     scene = build_scene(cassie, DEFAULT_PHYSICS_HZ, board=load_board("hovershoes"))
     result = Simulation(scene, rider, scenario).run()

@@ -210,6 +210,7 @@ class LinearMpc:
             self.reference.friction,
             self.pair.max_force,
             self.reference.min_board_share * self.pair.weight / len(index),
+            self.pair.pyramid,
         )
         u_lo, u_hi = force_bounds(index, window.contacts, self.pair.input_limits)
         for i, value in self._fixed:

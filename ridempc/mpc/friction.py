@@ -51,6 +51,7 @@ def friction_pyramids(
     friction: float,
     max_force: float,
     min_force: float = 0.0,
+    shape: str = "box",
 ) -> tuple[Array, Array, Array]:
     """Friction pyramids of every step (see the module docstring).
 
@@ -63,6 +64,7 @@ def friction_pyramids(
         friction: Coulomb coefficient :math:`\\mu` [-].
         max_force: :math:`f_{max}` [N].
         min_force: :math:`f_{min}` [N] of a contact on a board.
+        shape: The pyramid's shape (:func:`ridempc.friction.pyramid_rows`).
 
     Returns:
         :math:`G` (N x 5 n_c x nu), :math:`g^{lo}`, :math:`g^{hi}` (N x 5 n_c).
@@ -73,7 +75,7 @@ def friction_pyramids(
     lower = np.full((n, rows), -np.inf)
     upper = np.zeros((n, rows))
     # rows on phi: (phi_z, phi_x - s phi_z, ...), the tangent rows <= 0 (0.0 - x: no -0.0)
-    local = pyramid_matrix(friction)
+    local = pyramid_matrix(friction, shape)
     local[1:] = 0.0 - local[1:]
     kinds = np.array([[kind.value for kind in step] for step in schedule]).reshape(n, nc)
     on_board = kinds == Contact.BOARD.value

@@ -202,6 +202,7 @@ class MpcRider(Controller):
         settings_wbc = WbcSettings(
             springs="rigid" if sprung else "passive",
             force_weight=robot.params.wbc_force_weight,
+            pyramid=self.pair.pyramid,
         )
         self.wbc = WholeBodyController(
             robot,

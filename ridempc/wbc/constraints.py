@@ -244,17 +244,21 @@ class FrictionPyramidConstraint(Constraint):
               f_{min} \\le n^\\top f_s \\le f_{max}
 
     [N] for a site in contact (the pyramid implies :math:`n^\\top f_s \\ge 0`, so with
-    :math:`f_{min} = 0` the normal row only bounds from above). A site in the air gets no
-    force, :math:`f_s = 0`, as three equalities on the same rows,
-    :math:`(t_1 - s n)^\\top f_s = (t_2 - s n)^\\top f_s = n^\\top f_s = 0`, the other two
-    left free: pinning all five at zero would make a degenerate active set (five rows on
-    three unknowns), on which OSQP's polishing fails.
+    :math:`f_{min} = 0` the normal row only bounds from above), or in the ``diamond``
+    :math:`|t_1^\\top f_s| + |t_2^\\top f_s| \\le \\mu\\, n^\\top f_s`. A site in the air gets
+    no force, :math:`f_s = 0`, as three equalities on the same rows (the first and third
+    tangent rows and the normal: :math:`(t_1 - s n)^\\top f_s = (t_2 - s n)^\\top f_s =
+    n^\\top f_s = 0` in the box, :math:`(t_1 + t_2 - \\mu n)^\\top f_s = (t_2 - t_1 - \\mu
+    n)^\\top f_s = n^\\top f_s = 0` in the diamond), the other two left free: pinning all
+    five at zero would make a degenerate active set (five rows on three unknowns), on which
+    OSQP's polishing fails.
 
     Args:
         layout: The decision vector's layout.
         friction: Coulomb coefficient :math:`\\mu` [-].
         min_normal_force: :math:`f_{min}` [N].
         max_normal_force: :math:`f_{max}` [N].
+        shape: The pyramid's shape (:func:`ridempc.friction.pyramid_rows`).
     """
 
     def __init__(
@@ -263,6 +267,7 @@ class FrictionPyramidConstraint(Constraint):
         friction: float,
         min_normal_force: float,
         max_normal_force: float,
+        shape: str = "box",
     ) -> None:
         super().__init__(layout)
         self.friction = friction
@@ -283,8 +288,9 @@ class FrictionPyramidConstraint(Constraint):
         self._contact_upper = np.tile([0.0, 0.0, 0.0, 0.0, max_normal_force], layout.n_sites)
         self._swing_lower = np.tile([0.0, -INF, 0.0, -INF, 0.0], layout.n_sites)
         self._swing_upper = np.tile([0.0, INF, 0.0, INF, 0.0], layout.n_sites)
-        pyramid = pyramid_matrix(friction)
-        # rows t1 - s n, -t1 - s n, t2 - s n, -t2 - s n, n of the frame (t1, t2, n)
+        pyramid = pyramid_matrix(friction, shape)
+        # rows t1 - s n, -t1 - s n, t2 - s n, -t2 - s n, n of the frame (t1, t2, n) in the
+        # box; t1 + t2 - mu n, t1 - t2 - mu n, t2 - t1 - mu n, -t1 - t2 - mu n, n in the diamond
         self._pyramid = np.vstack([0.0 - pyramid[1:], pyramid[:1]])  # (no negative zeros)
 
     def compute_qp_constraint(

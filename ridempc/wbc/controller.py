@@ -168,7 +168,7 @@ class WholeBodyController:
             ClosedChainConstraint(layout),
             ContactAccelerationConstraint(layout, self.model.site_partner, self.model.line_basis),
             FrictionPyramidConstraint(
-                layout, s.friction, s.min_normal_force, s.max_normal_force * weight
+                layout, s.friction, s.min_normal_force, s.max_normal_force * weight, s.pyramid
             ),
             TorqueLimitConstraint(layout, np.array([m.torque_limit for m in self.robot.motors])),
         ]

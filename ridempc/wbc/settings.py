@@ -20,6 +20,7 @@ from types import MappingProxyType
 from typing import Literal
 
 from ridempc.errors import ConfigError
+from ridempc.friction import SHAPES
 
 __all__ = ["DEFAULT_OSQP_SETTINGS", "TrackingGains", "WbcSettings"]
 
@@ -64,6 +65,8 @@ class WbcSettings:
         friction: Coulomb friction coefficient :math:`\\mu` [-]; the QP keeps each force in
             its inner pyramid :math:`|f_{t_k}| \\le (\\mu/\\sqrt2) f_n`
             (:mod:`ridempc.friction`); keep it below the true friction.
+        pyramid: The pyramid's shape, ``box`` (above) or ``diamond``
+            (:math:`|f_{t_1}| + |f_{t_2}| \\le \\mu f_n`; :data:`ridempc.friction.SHAPES`).
         springs: How the QP treats the description's leaf springs: ``passive`` (known
             torques :math:`-k (q - q_{ref})` from the measured deflection) or ``rigid``
             (held still, their torque free; see
@@ -89,6 +92,7 @@ class WbcSettings:
     dt: float = 0.002
     track: Literal["com", "base"] = "com"
     friction: float = 0.6
+    pyramid: str = "box"
     springs: Literal["passive", "rigid"] = "passive"
     spring_damping: float = 20.0
     min_normal_force: float = 0.0
@@ -119,6 +123,11 @@ class WbcSettings:
         if self.friction <= 0.0:
             raise ConfigError(
                 f"WBC settings: field 'friction': must be positive, got {self.friction}"
+            )
+        if self.pyramid not in SHAPES:
+            raise ConfigError(
+                f"WBC settings: field 'pyramid': unknown '{self.pyramid}' "
+                f"(valid: {', '.join(SHAPES)})"
             )
         if not 0.0 <= self.min_normal_force:
             raise ConfigError("WBC settings: field 'min_normal_force': must be non-negative")
