@@ -118,7 +118,7 @@ class LinearMpc:
         self.structure = QPStructure(
             model.state_pattern,
             model.input_pattern,
-            pyramid_pattern(reference.force_index, model.nu),
+            pyramid_pattern(reference.force_index, model.nu, pair.tipping),
         )
         self.qp: MpcQP | None = None
         self._shift: tuple[bytes, StaticShift] | None = None  # the last static shift, by key
@@ -211,6 +211,7 @@ class LinearMpc:
             self.pair.max_force,
             self.reference.min_board_share * self.pair.weight / len(index),
             self.pair.pyramid,
+            self.pair.tipping,
         )
         u_lo, u_hi = force_bounds(index, window.contacts, self.pair.input_limits)
         for i, value in self._fixed:

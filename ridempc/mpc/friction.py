@@ -17,6 +17,15 @@ ground); five rows :math:`g^{lo} \\le G u \\le g^{hi}` per contact and step. A s
 with the same sparsity, whatever the contact schedule, which is what lets the QP keep one
 pattern. As in the paper (Sec. V-B), the rotations are those of the estimated state, held
 over the horizon.
+
+A platform on one wheel (a Hovershoe) also must not tip over its tread's edges: with its
+contacts' forces, their sideways axis :math:`t_{2,i}` and normal :math:`n_i`, two rows per
+platform and step,
+
+.. math:: \\sum_{i \\in P} (\\pm t_{2,i} - k\\, n_i)^\\top f_i \\le 0, \\qquad k = w / 2h
+
+(tread :math:`w`, deck height :math:`h`; the feet on the platform's axis, its own weight left
+out: :class:`~ridempc.wbc.constraints.PlatformTipConstraint` for the whole-body QP's).
 """
 
 from __future__ import annotations
@@ -32,14 +41,21 @@ from ridempc.trajopt.schedule import Contact
 __all__ = ["ROWS_PER_CONTACT", "force_bounds", "friction_pyramids", "pyramid_pattern"]
 
 Array = NDArray[np.float64]
+Tipping = Sequence[tuple[Sequence[int], float]]  # per platform: its contacts, w / 2h
 ROWS_PER_CONTACT = 5
 
 
-def pyramid_pattern(force_index: NDArray[np.int64], nu: int) -> NDArray[np.bool_]:
-    """Structural non-zeros of :math:`G_k` (5 n_c x nu): each row on its contact's force."""
-    pattern = np.zeros((ROWS_PER_CONTACT * len(force_index), nu), dtype=bool)
+def pyramid_pattern(
+    force_index: NDArray[np.int64], nu: int, tipping: Tipping = ()
+) -> NDArray[np.bool_]:
+    """Where :func:`friction_pyramids`' rows have entries (rows x nu)."""
+    nc = len(force_index)
+    pattern = np.zeros((ROWS_PER_CONTACT * nc + 2 * len(tipping), nu), dtype=bool)
     for i, columns in enumerate(force_index):
         pattern[ROWS_PER_CONTACT * i : ROWS_PER_CONTACT * (i + 1), columns] = True
+    for j, (contacts, _) in enumerate(tipping):
+        row = ROWS_PER_CONTACT * nc + 2 * j
+        pattern[row : row + 2, np.asarray(force_index)[list(contacts)].ravel()] = True
     return pattern
 
 
@@ -52,6 +68,7 @@ def friction_pyramids(
     max_force: float,
     min_force: float = 0.0,
     shape: str = "box",
+    tipping: Tipping = (),
 ) -> tuple[Array, Array, Array]:
     """Friction pyramids of every step (see the module docstring).
 
@@ -65,12 +82,14 @@ def friction_pyramids(
         max_force: :math:`f_{max}` [N].
         min_force: :math:`f_{min}` [N] of a contact on a board.
         shape: The pyramid's shape (:func:`ridempc.friction.pyramid_rows`).
+        tipping: Per platform that tips, its contacts and :math:`k = w / 2h` [-].
 
     Returns:
-        :math:`G` (N x 5 n_c x nu), :math:`g^{lo}`, :math:`g^{hi}` (N x 5 n_c).
+        :math:`G` (N x m x nu), :math:`g^{lo}`, :math:`g^{hi}` (N x m), m = 5 n_c plus two
+        per tipping platform.
     """
     n, nc = len(schedule), len(force_index)
-    rows = ROWS_PER_CONTACT * nc
+    rows = ROWS_PER_CONTACT * nc + 2 * len(tipping)
     matrix = np.zeros((n, rows, nu))
     lower = np.full((n, rows), -np.inf)
     upper = np.zeros((n, rows))
@@ -87,6 +106,13 @@ def friction_pyramids(
         matrix[:, block, force_index[i]] = rows_i
         lower[:, block.start] = np.where(on_board[:, i], min_force, 0.0)
         upper[:, block.start] = np.where(standing[:, i], max_force, 0.0)
+    for j, (contacts, ratio) in enumerate(tipping):
+        row = ROWS_PER_CONTACT * nc + 2 * j
+        for i in contacts:
+            rotation = np.asarray(surfaces[i])  # world from surface: columns t1, t2, n
+            side, normal = rotation[:, 1], rotation[:, 2]
+            matrix[:, row, force_index[i]] = side - ratio * normal
+            matrix[:, row + 1, force_index[i]] = -side - ratio * normal
     return matrix, lower, upper
 
 

@@ -19,6 +19,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards import load_board
+from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.errors import UnknownNameError
 from ridempc.trajopt.pairs import Pair, load_pair
 from ridempc.trajopt.ride_pair import ride_models
@@ -52,6 +54,9 @@ class MpcPair(NamedTuple):
             9 s instead of 1; straight riding within 0.003 m/s of the box's RMSE), ``box``
             elsewhere (the dog's push-off-0.7 reached 0.629 m/s in the diamond, 0.667 in
             the box: seed 0, measured).
+        tipping: Per platform that tips over its wheel's tread (a Hovershoe), its contacts
+            and :math:`k = w / 2h`, half the tread over the deck's height [-]
+            (:func:`~ridempc.mpc.friction.friction_pyramids`).
     """
 
     pair: Pair
@@ -61,6 +66,7 @@ class MpcPair(NamedTuple):
     max_force: float
     weight: float
     pyramid: str = "box"
+    tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -92,7 +98,17 @@ def _ride(robot: str, board: str, pyramid: str = "box") -> MpcPair:
     # The library's bound: one contact may carry the whole weight (ride_problem).
     pair = load_pair(robot, board)
     weight = rider.body.mass * GRAVITY
-    return MpcPair(pair, rider.contacts, surfaces, limits, weight, weight, pyramid)
+    tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
+    loaded = load_board(board)
+    params = loaded.params if loaded is not None else None
+    if isinstance(params, HovershoesParameters):
+        ratio = 0.5 * params.wheel_width / params.platform_height
+        platform_of = layout["platform_of"]
+        tipping = tuple(
+            (tuple(k for k, p in enumerate(platform_of) if p == i), ratio)
+            for i in range(wheeled.n_platforms)
+        )
+    return MpcPair(pair, rider.contacts, surfaces, limits, weight, weight, pyramid, tipping)
 
 
 MPC_PAIRS: dict[str, Callable[[], MpcPair]] = {

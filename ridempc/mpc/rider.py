@@ -129,7 +129,13 @@ def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
         return ()
     shoes = wheeled_board(board)
     assert isinstance(shoes, HovershoesBoard)
-    shoe = RollingPlatform(mass=shoes.shoe_mass, drive=shoes.reduced.c4)
+    params = board.params
+    shoe = RollingPlatform(
+        mass=shoes.shoe_mass,
+        drive=shoes.reduced.c4,
+        tread=params.wheel_width,
+        height=params.platform_height,
+    )
     return (shoe,) * shoes.n_platforms
 
 

@@ -30,6 +30,7 @@ __all__ = [
     "DynamicsConstraint",
     "FrictionPyramidConstraint",
     "LinearConstraint",
+    "PlatformTipConstraint",
     "RigidSpringConstraint",
     "TorqueLimitConstraint",
 ]
@@ -303,6 +304,49 @@ class FrictionPyramidConstraint(Constraint):
         lower = np.where(active, self._contact_lower, self._swing_lower)
         upper = np.where(active, self._contact_upper, self._swing_upper)
         return LinearConstraint(matrix, lower, upper)
+
+
+class PlatformTipConstraint(Constraint):
+    """A platform on one wheel does not tip over its tread's edges: the centre of pressure
+    of its ground contact stays within the tread, :math:`|y_c| \\le w/2`. With the forces
+    :math:`f_s` on the robot at the platform's sites, at height :math:`h` over the ground and
+    :math:`y_s` across the platform's axis, the moment balance about the axis gives
+    :math:`y_c = \\sum_s (y_s\\, n^\\top f_s - h\\, t_2^\\top f_s) / \\sum_s n^\\top f_s`,
+    so, per platform, two rows
+
+    .. math:: \\sum_s \\big((\\pm y_s / h - w/2h)\\, n - (\\pm t_2)\\big)^\\top f_s \\le 0
+
+    (:math:`t_2` the platform's sideways axis, :math:`n` its normal, from the contact set;
+    the shoe's own weight, which helps, is left out). A Hovershoe's tread is 0.09 m wide
+    under a deck 0.11 m high: the feet's net sideways force may be at most 0.41 of their
+    load, less than the diamond friction pyramid's 0.6 (:mod:`ridempc.friction`), which a
+    line foot needs to twist the shoe (with opposite sideways forces at its ends, which tip
+    nothing).
+
+    Args:
+        layout: The decision vector's layout.
+        platforms: How many platforms tip (rows for each; a platform without sites in a
+            tick keeps its rows empty).
+    """
+
+    def __init__(self, layout: DecisionLayout, platforms: int) -> None:
+        super().__init__(layout)
+        self.rows = 2 * platforms
+        self._lower = np.full(self.rows, -INF)
+        self._upper = np.zeros(self.rows)
+
+    def compute_qp_constraint(
+        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> LinearConstraint:
+        matrix = np.zeros((self.rows, self.layout.size))
+        start = self.layout.force.start
+        for j, (sites, offsets, ratio) in enumerate(contacts.tipping[: self.rows // 2]):
+            side, normal = contacts.frame[sites, 1], contacts.frame[sites, 2]
+            columns = (start + 3 * sites[:, None] + np.arange(3)).ravel()
+            for row, sign in ((2 * j, 1.0), (2 * j + 1, -1.0)):
+                rows = (sign * offsets - ratio)[:, None] * normal - sign * side
+                matrix[row, columns] = rows.ravel()
+        return LinearConstraint(matrix, self._lower.copy(), self._upper.copy())
 
 
 class TorqueLimitConstraint(Constraint):

@@ -41,6 +41,7 @@ from ridempc.wbc.constraints import (
     ContactAccelerationConstraint,
     DynamicsConstraint,
     FrictionPyramidConstraint,
+    PlatformTipConstraint,
     RigidSpringConstraint,
     TorqueLimitConstraint,
 )
@@ -171,6 +172,9 @@ class WholeBodyController:
                 layout, s.friction, s.min_normal_force, s.max_normal_force * weight, s.pyramid
             ),
             TorqueLimitConstraint(layout, np.array([m.torque_limit for m in self.robot.motors])),
+            PlatformTipConstraint(
+                layout, sum(p is not None and p.tread is not None for p in self.platforms)
+            ),
         ]
 
     def _probe_problems(self, stand: Array) -> list[QpProblem]:
@@ -188,7 +192,12 @@ class WholeBodyController:
             contacts = ContactSet.on_ground(np.full(n_sites, standing))
             if any(p is not None for p in self.platforms):
                 coupling = rng.normal(size=(n_sites, 3, n_sites, 3))
-                contacts = replace(contacts, coupling=coupling)
+                tipping = tuple(
+                    (np.arange(n_sites), rng.normal(size=n_sites), 0.4)
+                    for p in self.platforms
+                    if p is not None and p.tread is not None
+                )
+                contacts = replace(contacts, coupling=coupling, tipping=tipping)
             for s in range(n_sites):
                 contacts.frame[s] = pin.exp3(0.3 * rng.normal(size=3)).T
             targets = WbcTargets(

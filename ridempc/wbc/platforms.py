@@ -64,14 +64,22 @@ class RollingPlatform:
     Attributes:
         mass: :math:`m_s` [kg], the bare shoe (platform and wheel).
         drive: :math:`c_4` [N/rad], the firmware's forward force per radian of pitch.
+        tread: Width of the wheel's tread on the ground [m], about whose edges the shoe
+            tips sideways (None: it does not tip; :class:`~ridempc.wbc.constraints.
+            PlatformTipConstraint`).
+        height: Height of the deck's top, where the feet stand, over the ground [m].
     """
 
     mass: float
     drive: float
+    tread: float | None = None
+    height: float = 0.0
 
     def __post_init__(self) -> None:
         if not (self.mass > 0.0 and math.isfinite(self.drive)):
             raise ValueError(f"rolling platform: mass {self.mass} kg, drive {self.drive} N/rad")
+        if self.tread is not None and not (self.tread > 0.0 and self.height > 0.0):
+            raise ValueError(f"rolling platform: tread {self.tread} m, height {self.height} m")
 
     def response(self, board: BoardEstimate) -> PlatformResponse:
         """The shoe's response at the estimated pitch and heading."""
