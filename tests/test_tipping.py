@@ -40,7 +40,7 @@ def test_the_shoes_tip_at_half_their_tread_over_their_height() -> None:
 def _wbc_rows(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, DecisionLayout]:
     layout = DecisionLayout(nv=6, n_sites=2, n_motors=0)
     contacts = ContactSet.on_ground(np.array([True, True]))
-    tipping = ((np.array([0, 1]), offsets, RATIO),)
+    tipping = ((np.array([0, 1]), offsets, np.full(2, RATIO)),)
     contacts = ContactSet(contacts.active, contacts.frame, contacts.acceleration, None, tipping)
     block = PlatformTipConstraint(layout, 1).compute_qp_constraint(None, None, contacts)
     assert np.all(block.lower == -np.inf)

@@ -334,18 +334,35 @@ class PlatformTipConstraint(Constraint):
         self.rows = 2 * platforms
         self._lower = np.full(self.rows, -INF)
         self._upper = np.zeros(self.rows)
+        self._entries: dict[bytes, tuple[Index, Index, Index]] = {}
+
+    def _indices(self, sites: Index, counts: list[int]) -> tuple[Index, Index, Index]:
+        """The rows (+ and -) and columns of each site's three force components, for the
+        platforms' sites in a row (``counts`` each; a few distinct lists per ride)."""
+        key = sites.tobytes() + bytes(counts)
+        cached = self._entries.get(key)
+        if cached is None:
+            platform = np.repeat(np.arange(len(counts)), counts)
+            columns = (self.layout.force.start + 3 * sites[:, None] + np.arange(3)).ravel()
+            plus = np.repeat(2 * platform, 3)
+            cached = self._entries[key] = (plus, plus + 1, columns)
+        return cached
 
     def compute_qp_constraint(
         self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> LinearConstraint:
         matrix = np.zeros((self.rows, self.layout.size))
-        start = self.layout.force.start
-        for j, (sites, offsets, ratio) in enumerate(contacts.tipping[: self.rows // 2]):
-            side, normal = contacts.frame[sites, 1], contacts.frame[sites, 2]
-            columns = (start + 3 * sites[:, None] + np.arange(3)).ravel()
-            for row, sign in ((2 * j, 1.0), (2 * j + 1, -1.0)):
-                rows = (sign * offsets - ratio)[:, None] * normal - sign * side
-                matrix[row, columns] = rows.ravel()
+        tipping = contacts.tipping[: self.rows // 2]
+        if tipping:
+            counts = [len(t[0]) for t in tipping]
+            sites = np.concatenate([t[0] for t in tipping])
+            plus, minus, columns = self._indices(sites, counts)
+            offsets = np.concatenate([t[1] for t in tipping])[:, None]
+            ratio = np.concatenate([t[2] for t in tipping])[:, None]
+            axes = contacts.frame[sites]
+            side, normal = axes[:, 1], axes[:, 2]
+            matrix[plus, columns] = ((offsets - ratio) * normal - side).ravel()
+            matrix[minus, columns] = ((-offsets - ratio) * normal + side).ravel()
         return LinearConstraint(matrix, self._lower.copy(), self._upper.copy())
 
 

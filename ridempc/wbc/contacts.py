@@ -71,15 +71,15 @@ class ContactSet:
             (sites, 3, sites, 3); None where every support is rigid.
         tipping: Per platform that tips about its tread's edges, its sites, each site's
             sideways offset from the platform's axis over the deck's height
-            :math:`y_s / h` [-], and half the tread over the height :math:`w / 2h` [-]
-            (:class:`~ridempc.wbc.constraints.PlatformTipConstraint`).
+            :math:`y_s / h` [-], and (at each site) half the tread over the height
+            :math:`w / 2h` [-] (:class:`~ridempc.wbc.constraints.PlatformTipConstraint`).
     """
 
     active: NDArray[np.bool_]
     frame: Array
     acceleration: Array
     coupling: Array | None = None
-    tipping: tuple[tuple[Index, Array, float], ...] = ()
+    tipping: tuple[tuple[Index, Array, Array], ...] = ()
 
     @property
     def normal(self) -> Array:
@@ -151,7 +151,7 @@ def build_contact_set(
     frame = np.repeat(_AXES[None], n, axis=0)
     acceleration = np.zeros((n, 3))
     coupling: Array | None = None
-    tipping: list[tuple[Index, Array, float]] = []
+    tipping: list[tuple[Index, Array, Array]] = []
     for k, board in enumerate(boards):
         sites = _sites_on(site_foot, names, board.feet)
         if sites.size == 0:
@@ -172,6 +172,7 @@ def build_contact_set(
             coupling.ravel()[into] = response.coupling.ravel()[taken]
             if platform.tread is not None:
                 offsets = lever @ frame[sites[0], 1] / platform.height  # y_s / h
-                tipping.append((sites, offsets, 0.5 * platform.tread / platform.height))
+                ratio = np.full(len(sites), 0.5 * platform.tread / platform.height)
+                tipping.append((sites, offsets, ratio))
         acceleration[sites] = centripetal
     return ContactSet(active, frame, acceleration, coupling, tuple(tipping))

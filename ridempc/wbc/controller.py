@@ -193,7 +193,7 @@ class WholeBodyController:
             if any(p is not None for p in self.platforms):
                 coupling = rng.normal(size=(n_sites, 3, n_sites, 3))
                 tipping = tuple(
-                    (np.arange(n_sites), rng.normal(size=n_sites), 0.4)
+                    (np.arange(n_sites), rng.normal(size=n_sites), np.full(n_sites, 0.4))
                     for p in self.platforms
                     if p is not None and p.tread is not None
                 )
