@@ -79,6 +79,7 @@ from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.state_map import StateMap, forward_speed
+from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -246,6 +247,7 @@ class MpcRider(Controller):
         self._last_problem: MpcProblem | None = None
         self._plan_time = 0.0
         self._command_roll: tuple[float, float] | None = None
+        self._lean_shift: tuple[tuple[str, float], StaticShift] | None = None
         self._turned = 0.0  # [rad] the commanded yaw rate integrated over the ride
         self._turn_time: float | None = None
         self._turn_rate = 0.0
@@ -384,8 +386,7 @@ class MpcRider(Controller):
         if self.lean is not None:
             yaw_rate = float((estimate.rotation @ estimate.base_angular_velocity)[2])
             if self.lean.update(now, command.yaw_rate, yaw_rate, speed) != 0.0:
-                balance = self.mpc.static_shift(t_ref, names["com_y"], self.layout.rider_states)
-                problem = self.lean.lean(problem, names["com_y"], balance)
+                problem = self.lean.lean(problem, names["com_y"], self._lean_balance(t_ref))
             self._diagnostics["lean_offset"] = self.lean.offset
         if self.shoes is not None:
             columns = self._shoe_columns
@@ -406,6 +407,17 @@ class MpcRider(Controller):
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
+
+    def _lean_balance(self, t_ref: float) -> StaticShift:
+        """How the reference's forces move per metre of the lean's offset, found once per
+        manoeuvre at its first lean (the stance does not change over a speed change on
+        the Segway; found at every tick of a ramp, where the reference moves, it took
+        1.2 ms of the MPC tick)."""
+        key = (self.manoeuvre.kind, self.manoeuvre.target)
+        if self._lean_shift is None or self._lean_shift[0] != key:
+            names, rider = self.layout.names, self.layout.rider_states
+            self._lean_shift = (key, self.mpc.static_shift(t_ref, names["com_y"], rider))
+        return self._lean_shift[1]
 
     def _unwrapped(self, x0: Array, reference: Array) -> Array:
         """``x0`` with each heading (``*_yaw``, ``*_psi``) [rad] within :math:`\\pi` of the
