@@ -31,11 +31,13 @@ gives, so the rider holds that input at zero and leans instead, as the ``pd`` ba
    :math:`g` = ``LEAN_PULL``: the pad pushes back on the shins with a force that neither the
    MPC nor the whole-body QP models, and each MPC tick plans from where that force has
    left the rider, so the centre of mass settles at a fraction of its reference's offset.
-   Measured on the Segway's circle (2 m/s at 0.5 rad/s, seed 0): at :math:`g = 1` the lean
-   saturated at 0.1 m while the pelvis moved 0.012 m off the platform's centre, the bar
-   tilted 0.01 rad and the Segway turned at 0.07 rad/s (yaw-rate RMSE 0.429 rad/s); at 2.5,
-   4, 6 and 8 the RMSE was 0.304, 0.195, 0.087 and 0.057 rad/s (the ``pd`` baseline's 0.043),
-   the bar at about 0.06 rad.
+   Measured on the Segway's circle (2 m/s at 0.5 rad/s, seed 0) with a prototype that
+   lowered the reference by the ``pd`` rider's pelvis drop, 0.277 m: at :math:`g = 1` the
+   lean saturated at 0.1 m while the pelvis moved 0.012 m off the platform's centre, the
+   bar tilted 0.01 rad and the Segway turned at 0.07 rad/s (yaw-rate RMSE 0.429 rad/s); at
+   2.5, 4, 6 and 8 the RMSE was 0.304, 0.195, 0.087 and 0.057 rad/s (the ``pd`` baseline's
+   0.043), the bar at about 0.06 rad. As built (the keyframes' 0.255 m, :math:`g = 8`):
+   0.063 rad/s.
 
    The rider follows a commanded turn only while the board rolls at ``HEADING_SPEED`` or
    more, where the library frame turns with the board's direction of travel
