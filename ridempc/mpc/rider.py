@@ -20,7 +20,8 @@ Every 2 ms (500 Hz) the rider
    loop moves the reference's centre of mass sideways (:mod:`ridempc.mpc.lean`);
    on the Hovershoes the MPC also sees where each foot stands along its shoe and each
    shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
-   :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz;
+   :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, and each shoe's heading
+   reference is turned towards its line (:mod:`ridempc.mpc.guidance`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
    the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
@@ -66,6 +67,7 @@ from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
@@ -381,6 +383,11 @@ class MpcRider(Controller):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
         problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
+        if self.shoes is not None:  # each shoe's heading turned towards its line
+            states = steer_onto_lines(
+                problem.state_reference, problem.initial_state, self._shoe_columns
+            )
+            problem = replace(problem, state_reference=states)
         if self.crouch is not None:
             problem = self.crouch.lower(problem, names["com_z"], now)
         if self.lean is not None:
