@@ -58,6 +58,15 @@ class MpcPair(NamedTuple):
             and :math:`k = w / 2h`, half the tread over the deck's height [-] (with them
             the circle rode to 24.42 s of its 25, seed 0)
             (:func:`~ridempc.mpc.friction.friction_pyramids`).
+        force_time_constant: Time constant of the low-pass on the forces the whole-body
+            QP is given [s] (:class:`~ridempc.mpc.force_filter.ForceFilter`), or None to
+            pass the plan's first input as it is: 0.084 s on the Hovershoes, whose toes and
+            shoes rang at 7-9 Hz on the unfiltered forces (yaw-steps seeds 0/1/2/3: yaw-rate
+            RMSE 0.0617/0.0697/0.0626/fell at 21.87 s -> 0.0431/0.0431/0.0427/0.0414 rad/s;
+            but the circle, seeds 0/1, fell at 17.04/17.50 s instead of 22.69/18.81); None on the
+            Segway, where it quietened the toes too but velocity-steps fell at 15.38 s
+            (seed 0; circle yaw-rate RMSE 0.063 -> 0.071), and on the skateboard, whose
+            dog lifts its feet.
     """
 
     pair: Pair
@@ -68,6 +77,7 @@ class MpcPair(NamedTuple):
     weight: float
     pyramid: str = "box"
     tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
+    force_time_constant: float | None = None
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -89,7 +99,9 @@ def _skateboard() -> MpcPair:
     return MpcPair(pair, robot.feet, surfaces, limits, 2.0 * weight, weight)
 
 
-def _ride(robot: str, board: str, pyramid: str = "box") -> MpcPair:
+def _ride(
+    robot: str, board: str, pyramid: str = "box", force_time_constant: float | None = None
+) -> MpcPair:
     rider, wheeled = ride_models(robot, board)
     layout = ride_layout(rider, wheeled)
     x = ca.SX.sym("x", 12 + len(wheeled.state_names))
@@ -109,12 +121,24 @@ def _ride(robot: str, board: str, pyramid: str = "box") -> MpcPair:
             (tuple(k for k, p in enumerate(platform_of) if p == i), ratio)
             for i in range(wheeled.n_platforms)
         )
-    return MpcPair(pair, rider.contacts, surfaces, limits, weight, weight, pyramid, tipping)
+    return MpcPair(
+        pair,
+        rider.contacts,
+        surfaces,
+        limits,
+        weight,
+        weight,
+        pyramid,
+        tipping,
+        force_time_constant,
+    )
 
 
 MPC_PAIRS: dict[str, Callable[[], MpcPair]] = {
     "cyberdog2-skateboard": _skateboard,
-    "cassie-hovershoes": partial(_ride, "cassie", "hovershoes", pyramid="diamond"),
+    "cassie-hovershoes": partial(
+        _ride, "cassie", "hovershoes", pyramid="diamond", force_time_constant=0.084
+    ),
     "cassie-segway": partial(_ride, "cassie", "segway"),
 }
 

@@ -27,7 +27,8 @@ Every 2 ms (500 Hz) the rider
    the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
    first-step accelerations :math:`(v_1 - v_0)/\\Delta t` and
    :math:`(\\omega_1 - \\omega_0)/\\Delta t` fed forward, the first input's contact forces
-   (summed per foot), the feet in
+   (summed per foot; on the Hovershoes low-passed from solve to solve,
+   :mod:`ridempc.mpc.force_filter`), the feet in
    contact as the schedule has them over the step, and, for a foot the schedule lifts, a
    swing target where the reference puts it, carried by the estimated board
    (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
@@ -67,6 +68,7 @@ from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -221,6 +223,8 @@ class MpcRider(Controller):
             platforms=rolling_platforms(loaded),
         )
         self._feedforward = robot.params.wbc_feedforward
+        tau = self.pair.force_time_constant  # the forces the WBC gets, low-passed
+        self.force_filter = ForceFilter(tau) if tau is not None else None
         scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
         self.kp = scale * np.array([m.kp for m in robot.motors])
         self.kd = scale * np.array([m.kd for m in robot.motors])
@@ -407,6 +411,8 @@ class MpcRider(Controller):
         self._mpc_ms.append(1e3 * (time.perf_counter() - started))
         if not np.all(np.isfinite(plan.states)):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
+        if self.force_filter is not None:
+            plan = plan._replace(first_input=self.force_filter(plan.first_input, now))
         self._plan, self._plan_time = plan, now
         self._set_support(problem.contacts[0])
         self._diagnostics.update(
