@@ -387,11 +387,6 @@ class MpcRider(Controller):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
         problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
-        if self.shoes is not None:  # each shoe's heading turned towards its line
-            states = steer_onto_lines(
-                problem.state_reference, problem.initial_state, self._shoe_columns
-            )
-            problem = replace(problem, state_reference=states)
         if self.crouch is not None:
             problem = self.crouch.lower(problem, names["com_z"], now)
         if self.lean is not None:
@@ -399,9 +394,10 @@ class MpcRider(Controller):
             if self.lean.update(now, command.yaw_rate, yaw_rate, speed) != 0.0:
                 problem = self.lean.lean(problem, names["com_y"], self._lean_balance(t_ref))
             self._diagnostics["lean_offset"] = self.lean.offset
-        if self.shoes is not None:
-            columns = self._shoe_columns
-            states = self.shoes.shift_reference(problem.state_reference, columns)
+        if self.shoes is not None:  # each shoe's heading turned towards its line, its
+            columns = self._shoe_columns  # feet's place along it and its drag
+            states = steer_onto_lines(problem.state_reference, problem.initial_state, columns)
+            states = self.shoes.shift_reference(states, columns)
             c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
         if self.mpc.qp is None:

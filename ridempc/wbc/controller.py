@@ -118,6 +118,8 @@ class WholeBodyController:
     ) -> None:
         self.robot = robot
         self.platforms = tuple(platforms)
+        # How many platforms tip over their tread (PlatformTipConstraint's rows for each).
+        self._tipping = sum(p is not None and p.tread is not None for p in self.platforms)
         self.settings = settings or WbcSettings()
         self.model = WholeBodyModel(robot, pinocchio)
         self.motor_q = _motor_q(self.model.pinocchio, robot)
@@ -172,9 +174,7 @@ class WholeBodyController:
                 layout, s.friction, s.min_normal_force, s.max_normal_force * weight, s.pyramid
             ),
             TorqueLimitConstraint(layout, np.array([m.torque_limit for m in self.robot.motors])),
-            PlatformTipConstraint(
-                layout, sum(p is not None and p.tread is not None for p in self.platforms)
-            ),
+            PlatformTipConstraint(layout, self._tipping),
         ]
 
     def _probe_problems(self, stand: Array) -> list[QpProblem]:
@@ -194,8 +194,7 @@ class WholeBodyController:
                 coupling = rng.normal(size=(n_sites, 3, n_sites, 3))
                 tipping = tuple(
                     (np.arange(n_sites), rng.normal(size=n_sites), np.full(n_sites, 0.4))
-                    for p in self.platforms
-                    if p is not None and p.tread is not None
+                    for _ in range(self._tipping)
                 )
                 contacts = replace(contacts, coupling=coupling, tipping=tipping)
             for s in range(n_sites):
