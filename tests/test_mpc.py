@@ -409,6 +409,22 @@ def test_settings_are_checked() -> None:
         MpcSettings(horizon=0)
     assert MpcSettings().dt == pytest.approx(1.0 / 30.0)
     assert ROWS_PER_CONTACT == 5
+    with pytest.raises(ConfigError, match="terminal factor"):
+        MpcSettings(terminal_factor=-1.0)
+
+
+def test_the_terminal_weight_is_the_pairs_unless_the_settings_set_it() -> None:
+    """:math:`Q_N` is the pair's terminal factor times :math:`Q` (30 on the Hovershoes, 10
+    on the Segway), or the settings' where they give one."""
+    for board, factor in (("hovershoes", 30.0), ("segway", 10.0)):
+        mpc = LinearMpc.from_library("cassie", board, "accelerate", 0.5)
+        assert mpc.terminal_factor == mpc.pair.terminal_factor == pytest.approx(factor)
+        problem = mpc.problem(0.0, mpc.reference.states[0])
+        np.testing.assert_allclose(problem.final_weights, factor * problem.state_weights)
+    settings = MpcSettings(terminal_factor=2.0)
+    mpc = LinearMpc.from_library("cassie", "hovershoes", "accelerate", 0.5, settings=settings)
+    problem = mpc.problem(0.0, mpc.reference.states[0])
+    np.testing.assert_allclose(problem.final_weights, 2.0 * problem.state_weights)
 
 
 def test_fixed_inputs_are_held_over_the_horizon() -> None:
@@ -449,7 +465,8 @@ def test_a_ramped_command_retargets_in_steps_not_at_every_tick() -> None:
 
 def test_a_slower_speed_is_ridden_at_not_started_from_rest() -> None:
     """Slowing from 4 to 3.75 m/s picks the 3.75 m/s entry where it rides steadily, not
-    its start at rest; speeding up still starts where the reference passes the speed."""
+    its start at rest; speeding up still starts where the reference passes the speed, and
+    from rest where it first reaches the pair's start speed."""
     times = np.linspace(0.0, 8.0, 81)
     speeds = np.clip((times - 0.5) / 7.0, 0.0, 1.0) * 3.75  # rest -> 3.75 m/s
     slower = ManoeuvreSelector.phase_start(times, speeds, 3.97, 10.0, "accelerate")
@@ -457,6 +474,14 @@ def test_a_slower_speed_is_ridden_at_not_started_from_rest() -> None:
     faster = ManoeuvreSelector.phase_start(times, speeds, 1.5, 10.0, "accelerate")
     match = int(np.argmin(np.abs(times - (10.0 - faster))))
     assert speeds[match - 1] < 1.5 <= speeds[match]  # the first node at that speed
+    # from rest, the steady start and the slowest of the lean-in are skipped
+    assert 10.0 - ManoeuvreSelector.phase_start(times, speeds, 0.0, 10.0, "accelerate") == 0.0
+    lean = ManoeuvreSelector.phase_start(times, speeds, 0.0, 10.0, "accelerate", least=0.03)
+    match = int(np.argmin(np.abs(times - (10.0 - lean))))
+    assert speeds[match - 1] < 0.03 <= speeds[match]
+    stop = speeds[::-1]  # 3.75 m/s -> rest: a stop is matched on the speed alone
+    braking = ManoeuvreSelector.phase_start(times, stop, 1.0, 10.0, "stop", least=3.0)
+    assert braking == ManoeuvreSelector.phase_start(times, stop, 1.0, 10.0, "stop")
 
 
 def test_slowing_down_brakes_along_a_stop_then_rides_at_the_command() -> None:

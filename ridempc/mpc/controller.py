@@ -48,7 +48,8 @@ class MpcSettings:
     Attributes:
         horizon: N, steps [-].
         dt: Step [s] (30 Hz in the paper).
-        terminal_factor: :math:`Q_N = ` this :math:`\\times Q` [-].
+        terminal_factor: :math:`Q_N = ` this :math:`\\times Q` [-]; None: the pair's
+            (:attr:`~ridempc.mpc.pairs.MpcPair.terminal_factor`).
         weights: Overrides of :math:`Q` and :math:`R` by state or input name.
         osqp: Overrides of the QP's OSQP settings.
         fixed_inputs: Inputs held at a value over the whole horizon, by name (an input the
@@ -58,7 +59,7 @@ class MpcSettings:
 
     horizon: int = 12
     dt: float = MPC_STEP
-    terminal_factor: float = 10.0
+    terminal_factor: float | None = None
     weights: Mapping[str, float] = field(default_factory=dict)
     osqp: Mapping[str, float | int | bool] = field(default_factory=dict)
     fixed_inputs: Mapping[str, float] = field(default_factory=dict)
@@ -68,7 +69,7 @@ class MpcSettings:
             raise ConfigError(f"MPC horizon must be at least 1 step, got {self.horizon}")
         if not self.dt > 0.0:
             raise ConfigError(f"MPC step must be positive, got {self.dt} s")
-        if not self.terminal_factor >= 0.0:
+        if self.terminal_factor is not None and not self.terminal_factor >= 0.0:
             raise ConfigError(
                 f"MPC terminal factor must be non-negative, got {self.terminal_factor}"
             )
@@ -122,6 +123,12 @@ class LinearMpc:
         )
         self.qp: MpcQP | None = None
         self._shift: tuple[bytes, StaticShift] | None = None  # the last static shift, by key
+
+    @property
+    def terminal_factor(self) -> float:
+        """:math:`Q_N / Q` [-], the settings' or else the pair's."""
+        factor = self.settings.terminal_factor
+        return self.pair.terminal_factor if factor is None else factor
 
     def _fixed_indices(self, fixed: Mapping[str, float]) -> list[tuple[int, float]]:
         names = list(self.reference.input_names)
@@ -231,7 +238,7 @@ class LinearMpc:
             constraint_lower=g_lo,
             constraint_upper=g_hi,
             dt=s.dt,
-            terminal_weights=s.terminal_factor * self.state_weights,
+            terminal_weights=self.terminal_factor * self.state_weights,
             contacts=window.contacts,
         )
 

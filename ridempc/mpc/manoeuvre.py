@@ -9,7 +9,9 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   the two neighbouring ones where the library allows it), started *at the phase where the
   reference's speed equals the rider's estimated speed* (its centre of mass's, along the
   board's heading, as the reference's ``vx`` is), so a step from 0.5 to 1.0 m/s picks
-  up the 1.0 m/s push where it passes 0.5 m/s; after its end the reference rides on steadily
+  up the 1.0 m/s push where it passes 0.5 m/s, and one from rest where it passes the pair's
+  start speed (:attr:`~ridempc.mpc.pairs.MpcPair.start_speed`); after its end the
+  reference rides on steadily
   (where the library has no ``stop``, the skateboard, which only a push drives, it
   **coasts**: the steady ride slowed to the board's speed, :meth:`ManoeuvreSelector.coasting`);
   while the command is ramping, it is kept as long as the command stays within
@@ -204,9 +206,15 @@ class ManoeuvreSelector:
         return goal
 
     @staticmethod
-    def phase_start(times: Array, speeds: Array, speed: float, now: float, kind: str) -> float:
+    def phase_start(
+        times: Array, speeds: Array, speed: float, now: float, kind: str, least: float = 0.0
+    ) -> float:
         """The start time that puts ``now`` at the reference's first time where its speed
         reaches ``speed`` (rising for ``accelerate``, falling for ``stop``).
+
+        An ``accelerate`` matches at least ``least`` [m/s]: started from rest, it skips the
+        reference's steady start and whatever of the lean-in is slower than that
+        (:attr:`~ridempc.mpc.pairs.MpcPair.start_speed`).
 
         A rider already faster than the whole ``accelerate`` reference (a slow-down to a
         lower speed that is not rest) starts at the reference's end, riding steadily at
@@ -214,6 +222,7 @@ class ManoeuvreSelector:
         rider at 4 m/s for 0 m/s at once (the Segway's stop from 4 m/s fell in 0.3 s).
         """
         if kind == "accelerate":
+            speed = max(speed, least)
             reached = np.nonzero(speeds >= speed)[0]
             beyond = speed > float(speeds[-1])
         else:

@@ -67,6 +67,24 @@ class MpcPair(NamedTuple):
             Segway, where it quietened the toes too but velocity-steps fell at 15.38 s
             (seed 0; circle yaw-rate RMSE 0.063 -> 0.071), and on the skateboard, whose
             dog lifts its feet.
+        terminal_factor: The MPC's terminal weight over its stage weight,
+            :math:`Q_N = ` this :math:`\\times Q` [-], standing in for the cost beyond the
+            0.4 s horizon: 30 on the Hovershoes, 10 elsewhere. At 10 the Hovershoes' plans
+            let the rider roll back at rest, each ending 0.1 m behind its reference and
+            0.07 m/s slower, and the rides settled 0.03-0.04 m/s short of each commanded
+            speed. From 10 to 30 (seed 0): stand-still's velocity RMSE 0.0566 -> 0.0128
+            m/s, offset-start's 0.0548 -> 0.0110, push's 0.0601 -> 0.0471, wave's 0.0413 ->
+            0.0067, velocity-steps' 0.1425 -> 0.1228 (seed 1: 0.1417 -> 0.1190), yaw-steps'
+            yaw-rate RMSE 0.0431 -> 0.0433 rad/s, and the circle, which fell at 17.04 s,
+            rides through. At 20 velocity-steps gave 0.1237; at 50 and 100 the plans pitched
+            the shoes so hard for the step from 1.0 to 1.5 m/s that they ran from under the
+            rider (fell at 23.83 and 13.98 s).
+        start_speed: An ``accelerate`` from rest starts where its reference first reaches
+            this speed [m/s] (:meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.phase_start`),
+            skipping the library's steady start and the slowest of its lean-in: 0.06 on the
+            Hovershoes (velocity-steps seed 0, velocity RMSE 0.1228 at 0, 0.1126 at 0.03,
+            0.1102 at 0.06, 0.1085 at 0.1; seed 1 0.1190 -> 0.1070 at 0.06), 0 elsewhere
+            (the dog's push-offs start with the board still).
     """
 
     pair: Pair
@@ -78,6 +96,8 @@ class MpcPair(NamedTuple):
     pyramid: str = "box"
     tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
     force_time_constant: float | None = None
+    terminal_factor: float = 10.0
+    start_speed: float = 0.0
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -100,7 +120,12 @@ def _skateboard() -> MpcPair:
 
 
 def _ride(
-    robot: str, board: str, pyramid: str = "box", force_time_constant: float | None = None
+    robot: str,
+    board: str,
+    pyramid: str = "box",
+    force_time_constant: float | None = None,
+    terminal_factor: float = 10.0,
+    start_speed: float = 0.0,
 ) -> MpcPair:
     rider, wheeled = ride_models(robot, board)
     layout = ride_layout(rider, wheeled)
@@ -131,13 +156,21 @@ def _ride(
         pyramid,
         tipping,
         force_time_constant,
+        terminal_factor,
+        start_speed,
     )
 
 
 MPC_PAIRS: dict[str, Callable[[], MpcPair]] = {
     "cyberdog2-skateboard": _skateboard,
     "cassie-hovershoes": partial(
-        _ride, "cassie", "hovershoes", pyramid="diamond", force_time_constant=0.084
+        _ride,
+        "cassie",
+        "hovershoes",
+        pyramid="diamond",
+        force_time_constant=0.084,
+        terminal_factor=30.0,
+        start_speed=0.06,
     ),
     "cassie-segway": partial(_ride, "cassie", "segway"),
 }

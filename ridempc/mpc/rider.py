@@ -367,6 +367,7 @@ class MpcRider(Controller):
                 rider_speed,
                 now,
                 wanted.kind,
+                self.pair.start_speed,
             )
             self.manoeuvre = replace(wanted, start=start)
             self._anchor(estimate, now)
