@@ -125,13 +125,14 @@ def test_ride_targets_beyond_the_speed_limit_are_refused(board: str) -> None:
 
 def test_a_pairs_own_options_set_its_manoeuvre_times() -> None:
     """A speed change takes ``2 settle + manoeuvre_base + seconds_per_speed * dv``: the
-    Hovershoes' own defaults (0.4 s + 0.8 s per m/s) make their accelerate to 1.0 m/s 2.2 s
-    long, the Segway's (the RideOptions defaults, 1 s + 2 s per m/s) 4 s; an entry's own
+    pairs' own defaults (0.4 s + 0.8 s per m/s, not RideOptions' 1 s + 2 s per m/s) make an
+    accelerate to 1.0 m/s 2.2 s long, on the Segway on a grid of 0.0125 s; an entry's own
     options override the pair's."""
-    for board, seconds, base in (("hovershoes", 2.2, 0.4), ("segway", 4.0, 1.0)):
+    for board, step in (("hovershoes", 0.025), ("segway", 0.0125)):
         problem = load_pair("cassie", board).build(EntrySpec("accelerate", 1.0))
-        assert problem.times[-1] == pytest.approx(seconds), board
-        assert problem.metadata["options"]["manoeuvre_base"] == base
+        assert problem.times[-1] == pytest.approx(2.2), board
+        assert problem.metadata["options"]["manoeuvre_base"] == 0.4
+        assert problem.times[1] - problem.times[0] == pytest.approx(step), board
     hovershoes = load_pair("cassie", "hovershoes")
     slow = hovershoes.build(EntrySpec("accelerate", 1.0, {"seconds_per_speed": 2.0}))
     assert slow.times[-1] == pytest.approx(3.4)
