@@ -13,11 +13,14 @@ the faster ones 0.066.
 
 from ridempc.trajopt.ride_pair import make_ride_pair
 
-__all__ = ["PAIR"]
+__all__ = ["PAIR", "SPEED_CHANGES"]
+
+# The speed changes' timing (RideOptions' fields), the Segway's too.
+SPEED_CHANGES: dict[str, float] = {"seconds_per_speed": 0.8, "manoeuvre_base": 0.4}
 
 PAIR = make_ride_pair(
     "cassie",
     "hovershoes",
     default_targets=(0.5, 1.0, 1.5),
-    options={"seconds_per_speed": 0.8, "manoeuvre_base": 0.4},
+    options=SPEED_CHANGES,
 )

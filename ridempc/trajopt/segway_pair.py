@@ -10,6 +10,7 @@ The grid is 0.0125 s, half RideOptions': on 0.025 s these faster entries were up
 (state units) from an RK45 re-simulation over one interval, on 0.0125 s 0.0016.
 """
 
+from ridempc.trajopt.hovershoes_pair import SPEED_CHANGES
 from ridempc.trajopt.ride_pair import make_ride_pair
 
 __all__ = ["PAIR"]
@@ -18,5 +19,5 @@ PAIR = make_ride_pair(
     "cassie",
     "segway",
     default_targets=(0.5, 1.0, 2.0, 3.0, 4.0),
-    options={"seconds_per_speed": 0.8, "manoeuvre_base": 0.4, "dt": 0.0125},
+    options={**SPEED_CHANGES, "dt": 0.0125},
 )
