@@ -269,6 +269,8 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     assert rider.wbc.settings.force_weight == pytest.approx(cassie.params.wbc_force_weight)
     assert rider.wbc.settings.pyramid == rider.pair.pyramid == "diamond"
     assert rider.mpc.terminal_factor == rider.pair.terminal_factor == pytest.approx(30.0)
+    # each shoe's heading read off its direction of travel too (the soles creep round)
+    assert rider.shoe_heading is not None and rider.shoe_heading.platforms == 2
     scenario = resolve_scenario("stand-still", "hovershoes").with_duration(2.0)
     scene = build_scene(cassie, DEFAULT_PHYSICS_HZ, board=load_board("hovershoes"))
     result = Simulation(scene, rider, scenario).run()

@@ -76,9 +76,11 @@ class MpcPair(NamedTuple):
             m/s, offset-start's 0.0548 -> 0.0110, push's 0.0601 -> 0.0471, wave's 0.0413 ->
             0.0067, velocity-steps' 0.1425 -> 0.1228 (seed 1: 0.1417 -> 0.1190), yaw-steps'
             yaw-rate RMSE 0.0431 -> 0.0433 rad/s, and the circle, which fell at 17.04 s,
-            rides through. At 20 velocity-steps gave 0.1237; at 50 and 100 the plans pitched
-            the shoes so hard for the step from 1.0 to 1.5 m/s that they ran from under the
-            rider (fell at 23.83 and 13.98 s).
+            rode to its end, its shoes drifting apart (0.42 -> 0.57 m, seed 1) until their
+            headings were read off their travel (:mod:`~ridempc.mpc.shoe_heading`). At 20
+            velocity-steps gave 0.1237; at 50 and 100 the plans pitched the shoes so hard
+            for the step from 1.0 to 1.5 m/s that they ran from under the rider (fell at
+            23.83 and 13.98 s).
         start_speed: An ``accelerate`` from rest starts where its reference first reaches
             this speed [m/s] (:meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.phase_start`),
             skipping the library's steady start and the slowest of its lean-in: 0.06 on the

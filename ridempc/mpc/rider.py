@@ -20,7 +20,9 @@ Every 2 ms (500 Hz) the rider
    loop moves the reference's centre of mass sideways (:mod:`ridempc.mpc.lean`);
    on the Hovershoes the MPC also sees where each foot stands along its shoe and each
    shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
-   :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, and each shoe's heading
+   :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, each shoe's heading is
+   read off its direction of travel where its foot's toe line has crept round on it
+   (:mod:`ridempc.mpc.shoe_heading`, at 500 Hz, for the WBC too), and each shoe's heading
    reference is turned towards its line (:mod:`ridempc.mpc.guidance`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
@@ -81,6 +83,7 @@ from ridempc.mpc.manoeuvre import (
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
@@ -233,6 +236,8 @@ class MpcRider(Controller):
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
         self.shoes = self._shoe_observer(loaded)
+        # each shoe's heading from its direction of travel: the soles creep round on the pads
+        self.shoe_heading = ShoeHeading(self.shoes.platforms) if self.shoes is not None else None
         n = self.layout.names  # each shoe's (x, y, heading, speed) indices in the MPC's state
         self._shoe_columns = (
             tuple((n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes)
@@ -332,6 +337,8 @@ class MpcRider(Controller):
             np.all(np.isfinite(estimate.q)) and np.all(np.isfinite(estimate.v))
         ):
             return self._safe_hold(sensors, f"state estimate not finite at {sensors.time:.3f} s")
+        if self.shoe_heading is not None:
+            estimate = self.shoe_heading(estimate)
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
