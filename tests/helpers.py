@@ -6,6 +6,8 @@ import numpy as np
 
 from ridempc.controllers.base import Controller
 from ridempc.controllers.stand import StandController
+from ridempc.estimation import EstimatedState
+from ridempc.estimation.state import BoardEstimate
 from ridempc.scenarios.scenario import Command, Scenario
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -64,3 +66,23 @@ def assert_gain_edit_refused(default_file, tmp_path, old: str, new: str, field: 
     with pytest.raises(ConfigError, match=field.replace(".", r"\.")) as info:
         build(path)
     assert str(path) in str(info.value)
+
+
+def board_estimate(t: float, boards: tuple[BoardEstimate, ...]) -> EstimatedState:
+    """An estimate that carries only the time and the platforms (for the board observers)."""
+    return EstimatedState(
+        time=t,
+        base_position=np.zeros(3),
+        base_quaternion=np.array([1.0, 0.0, 0.0, 0.0]),
+        base_velocity=np.zeros(3),
+        base_angular_velocity=np.zeros(3),
+        joint_position={},
+        joint_velocity={},
+        q=np.zeros(7),
+        v=np.zeros(6),
+        foot_names=("left", "right"),
+        contact=np.ones(2, dtype=bool),
+        foot_position=np.zeros((2, 3)),
+        foot_velocity=np.zeros((2, 3)),
+        boards=boards,
+    )

@@ -8,32 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ridempc.estimation import EstimatedState
 from ridempc.estimation.state import BoardEstimate
 from ridempc.mpc.shoe_heading import MIN_SPEED, TIME_CONSTANT, ShoeHeading
+from tests.helpers import board_estimate
 
 DT = 0.002  # [s] the rider's tick
 RNG = np.random.default_rng(0)
-
-
-def _estimate(t: float, boards: tuple[BoardEstimate, ...]) -> EstimatedState:
-    """An estimate that carries only what the filter reads: the time and the platforms."""
-    return EstimatedState(
-        time=t,
-        base_position=np.zeros(3),
-        base_quaternion=np.array([1.0, 0.0, 0.0, 0.0]),
-        base_velocity=np.zeros(3),
-        base_angular_velocity=np.zeros(3),
-        joint_position={},
-        joint_velocity={},
-        q=np.zeros(7),
-        v=np.zeros(6),
-        foot_names=("left", "right"),
-        contact=np.ones(2, dtype=bool),
-        foot_position=np.zeros((2, 3)),
-        foot_velocity=np.zeros((2, 3)),
-        boards=boards,
-    )
 
 
 def _shoe(heading: float, creep: float, speed: float, noise: float) -> BoardEstimate:
@@ -61,7 +41,7 @@ def _ride(filter_: ShoeHeading, seconds: float, speeds: tuple[float, float], t0:
         truth = (0.4 * t, 0.4 * t + 0.05)
         creep = 0.012 * t
         boards = tuple(_shoe(h, creep, v, 0.03) for h, v in zip(truth, speeds, strict=True))
-        corrected = filter_(_estimate(t, boards))
+        corrected = filter_(board_estimate(t, boards))
         out.append((np.array(truth), np.array([b.yaw for b in corrected.boards])))
     return out
 
@@ -92,10 +72,10 @@ def test_a_shoe_rolling_backwards_is_read_along_its_heading() -> None:
     filter_ = ShoeHeading(1)
     for tick in range(int(5.0 / DT)):
         board = replace(_shoe(1.0, 0.1, 0.0, 0.0), velocity=-0.6 * np.array([0.54, 0.84, 0.0]))
-        heading = filter_(_estimate(tick * DT, (board,))).boards[0].yaw
+        heading = filter_(board_estimate(tick * DT, (board,))).boards[0].yaw
     assert heading == pytest.approx(math.atan2(0.84, 0.54), abs=0.01)
 
 
 def test_an_estimate_without_its_shoes_passes_through() -> None:
-    estimate = _estimate(0.0, ())
+    estimate = board_estimate(0.0, ())
     assert ShoeHeading(2)(estimate) is estimate

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from ridempc.boards import load_board
-from ridempc.estimation import EstimatedState
 from ridempc.estimation.state import BoardEstimate
 from ridempc.mpc.rider import MpcRider
 from ridempc.mpc.shoe_observer import LIMIT, ShoeObserver
@@ -18,6 +17,7 @@ from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
+from tests.helpers import board_estimate
 
 HALF_FOOT = 0.08  # [m] each foot's two sites this far ahead of and behind its centroid
 DT = 0.002  # [s] the rider's tick
@@ -28,26 +28,6 @@ def shoes() -> HovershoesBoard:
     board = wheeled_board(load_board("hovershoes"))
     assert isinstance(board, HovershoesBoard)
     return board
-
-
-def _estimate(t: float, boards: tuple[BoardEstimate, ...]) -> EstimatedState:
-    """An estimate that carries only what the observer reads: the time and the platforms."""
-    return EstimatedState(
-        time=t,
-        base_position=np.zeros(3),
-        base_quaternion=np.array([1.0, 0.0, 0.0, 0.0]),
-        base_velocity=np.zeros(3),
-        base_angular_velocity=np.zeros(3),
-        joint_position={},
-        joint_velocity={},
-        q=np.zeros(7),
-        v=np.zeros(6),
-        foot_names=("left", "right"),
-        contact=np.ones(2, dtype=bool),
-        foot_position=np.zeros((2, 3)),
-        foot_velocity=np.zeros((2, 3)),
-        boards=boards,
-    )
 
 
 def _ride_shoes(
@@ -93,7 +73,7 @@ def _ride_shoes(
             theta_dot[k] += DT * theta_ddot
             theta[k] += DT * theta_dot[k]
             speed[k] += DT * speed_dot
-        observer.update(_estimate(t, tuple(boards)), np.array(positions), np.array(forces))
+        observer.update(board_estimate(t, tuple(boards)), np.array(positions), np.array(forces))
         out.append((t, observer.offsets.copy(), observer.drag.copy()))
     return out
 
@@ -117,7 +97,7 @@ def test_moves_the_mpc_shoes_behind_their_feet_and_adds_the_drag(shoes) -> None:
     observer.offsets = np.array([0.04, -0.02])
     observer.drag = np.array([2.0, 0.0])
     board = BoardEstimate(("a",), np.array([1.0, 2.0, 0.1]), 0.5, 0.0, 0.0, np.zeros(3), 0.0)
-    moved = observer.shift(_estimate(0.0, (board, board)))
+    moved = observer.shift(board_estimate(0.0, (board, board)))
     np.testing.assert_allclose(
         moved.boards[0].position, [1.0 - 0.04 * math.cos(0.5), 2.0 - 0.04 * math.sin(0.5), 0.1]
     )
