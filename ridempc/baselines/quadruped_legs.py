@@ -36,6 +36,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.estimation.rotations import wrap_angle
 from ridempc.robots.pinocchio_model import PinocchioRobot
 
 __all__ = ["LegKinematics", "QuadrupedLegs", "rotation_y"]
@@ -139,10 +140,10 @@ class LegKinematics:
         if not -1.0 <= cos_knee <= 1.0:
             reachable, cos_knee = False, min(1.0, max(-1.0, cos_knee))
         offset = cmath.phase(s) - cmath.phase(t)
-        branch = 1.0 if _wrap(reference[2] + offset) >= 0.0 else -1.0
+        branch = 1.0 if wrap_angle(reference[2] + offset) >= 0.0 else -1.0
         q3 = branch * math.acos(cos_knee) - offset
         q2 = cmath.phase(target) - cmath.phase(t + cmath.exp(1j * q3) * s)
-        return np.array([_wrap(q1), _wrap(q2), _wrap(q3)]), reachable
+        return np.array([wrap_angle(q1), wrap_angle(q2), wrap_angle(q3)]), reachable
 
     @property
     def _thigh_c(self) -> complex:
@@ -151,10 +152,6 @@ class LegKinematics:
     @property
     def _shank_c(self) -> complex:
         return _sagittal(self.shank)
-
-
-def _wrap(angle: float) -> float:
-    return float((angle + math.pi) % (2.0 * math.pi) - math.pi)
 
 
 class QuadrupedLegs:

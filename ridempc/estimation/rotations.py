@@ -17,6 +17,7 @@ __all__ = [
     "matrix_to_quaternion",
     "quaternion_to_matrix",
     "rpy_of_matrix",
+    "wrap_angle",
     "yaw_of",
 ]
 
@@ -55,6 +56,11 @@ def matrix_to_quaternion(rotation: Array) -> Array:
         quat[1 + k] = (m[k, i] + m[i, k]) / s
     quat /= np.linalg.norm(quat)
     return quat if quat[0] >= 0.0 else -quat
+
+
+def wrap_angle(angle: float) -> float:
+    """``angle`` [rad] wrapped into :math:`[-\\pi, \\pi)`."""
+    return float((angle + math.pi) % (2.0 * math.pi) - math.pi)
 
 
 def yaw_of(quat_wxyz: Array) -> float:

@@ -43,16 +43,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from ridempc.estimation.rotations import wrap_angle
 from ridempc.estimation.state import BoardEstimate, EstimatedState
 
 __all__ = ["MIN_SPEED", "TIME_CONSTANT", "ShoeHeading"]
 
 MIN_SPEED: float = 0.25  # [m/s] below this a shoe's slip estimate is held
 TIME_CONSTANT: float = 1.0  # [s] the slip's low-pass
-
-
-def _wrap(angle: float) -> float:
-    return math.remainder(angle, 2.0 * math.pi)
 
 
 class ShoeHeading:
@@ -91,6 +88,6 @@ class ShoeHeading:
                 travel = math.atan2(vy, vx)
                 if vx * math.cos(board.yaw) + vy * math.sin(board.yaw) < 0.0:
                     travel += math.pi  # rolling backwards
-                self.slip[k] += share * _wrap(board.yaw - travel - self.slip[k])
-            boards.append(replace(board, yaw=_wrap(board.yaw - float(self.slip[k]))))
+                self.slip[k] += share * wrap_angle(board.yaw - travel - self.slip[k])
+            boards.append(replace(board, yaw=wrap_angle(board.yaw - float(self.slip[k]))))
         return replace(estimate, boards=tuple(boards))

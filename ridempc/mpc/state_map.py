@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState
-from ridempc.estimation.rotations import rpy_of_matrix
+from ridempc.estimation.rotations import rpy_of_matrix, wrap_angle
 from ridempc.estimation.state import BoardEstimate
 from ridempc.robots.pinocchio_model import PinocchioRobot
 
@@ -71,10 +71,6 @@ def forward_speed(board: BoardEstimate) -> float:
     """The platform's speed along its heading, :math:`\\dot c \\cdot (\\cos\\psi, \\sin\\psi)`
     [m/s]."""
     return _along(board.velocity, board.yaw)
-
-
-def _wrap(angle: float) -> float:
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 @dataclass(frozen=True)
@@ -133,7 +129,7 @@ class _AngleRate:
     def __call__(self, time: float, angle: float) -> float:
         if self.previous is not None and time > self.previous[0]:
             dt = time - self.previous[0]
-            raw = _wrap(angle - self.previous[1]) / dt
+            raw = wrap_angle(angle - self.previous[1]) / dt
             alpha = 1.0 - math.exp(-2.0 * math.pi * self.hz * dt)
             self.rate += alpha * (raw - self.rate)
         self.previous = (time, angle)
@@ -230,7 +226,7 @@ class StateMap:
         com_velocity = np.array(data.vcom[0])
         rotation = estimate.rotation
         roll, pitch, yaw = rpy_of_matrix(rotation)
-        angles = (roll, pitch, _wrap(yaw - self.frame.yaw))
+        angles = (roll, pitch, wrap_angle(yaw - self.frame.yaw))
         com_lib = self.frame.point_to_library(com)
         velocity_lib = self.frame.vector_to_library(com_velocity)
         x = np.empty(len(self.names))
@@ -265,7 +261,7 @@ class StateMap:
         else:
             yaw_world, position = board.yaw, board.position
         x_ref, y_ref, yaw_ref = board_pose
-        self.frame = PlanarFrame.through(_wrap(yaw_world - yaw_ref), (x_ref, y_ref), position)
+        self.frame = PlanarFrame.through(wrap_angle(yaw_world - yaw_ref), (x_ref, y_ref), position)
 
     def follow_sideways(
         self,
@@ -323,10 +319,10 @@ class StateMap:
         if heading and math.hypot(vx, vy) > HEADING_SPEED:
             travel = math.atan2(vy, vx)
             if forward_speed(board) < 0.0:
-                travel = _wrap(travel + math.pi)
-            wanted = _wrap(travel - yaw_ref)
+                travel = wrap_angle(travel + math.pi)
+            wanted = wrap_angle(travel - yaw_ref)
             share = min(1.0, (estimate.time - self._heading_time) / HEADING_FILTER_S)
-            yaw = self.frame.yaw + share * _wrap(wanted - self.frame.yaw)
+            yaw = self.frame.yaw + share * wrap_angle(wanted - self.frame.yaw)
             kept = self.frame.point_to_library(board.position)
             self.frame = PlanarFrame.through(yaw, kept, board.position)
         self._heading_time = estimate.time
