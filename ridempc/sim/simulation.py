@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, SimulationDiverged
+from ridempc.heap import frozen_heap
 from ridempc.scenarios.scenario import Disturbance, ParameterChange, Scenario
 from ridempc.sim.clock import Rate
 from ridempc.sim.falls import FallDetector
@@ -286,39 +287,40 @@ class Simulation:
         times: list[float] = []
         friction, masses = model.geom_friction.copy(), model.body_mass.copy()
         result = RunResult(status="ok", sim_time=0.0, wall_time=0.0)
-        start = time.perf_counter()
         tick = 0
-        try:
-            for tick in range(n_ticks + 1):
-                t = tick / hz
-                if self.log_rate.due(tick):
-                    self._check_finite(t, data)
-                    self._log_row(recorder, t, data)
-                    reason = self.falls.check(model, data)
-                    if reason is not None:
-                        result.status, result.fall_time, result.fall_reason = "fell", t, reason
+        with frozen_heap():  # the models and the library stay out of the collector's walks
+            start = time.perf_counter()
+            try:
+                for tick in range(n_ticks + 1):
+                    t = tick / hz
+                    if self.log_rate.due(tick):
+                        self._check_finite(t, data)
+                        self._log_row(recorder, t, data)
+                        reason = self.falls.check(model, data)
+                        if reason is not None:
+                            result.status, result.fall_time, result.fall_reason = "fell", t, reason
+                            break
+                    if self.on_frame is not None and self.frame_rate.due(tick):
+                        self.on_frame(model, data)
+                    if tick == n_ticks:
                         break
-                if self.on_frame is not None and self.frame_rate.due(tick):
-                    self.on_frame(model, data)
-                if tick == n_ticks:
-                    break
-                self._apply_changes(tick, model)
-                self._apply_disturbances(t, data)
-                if self.external is not None:
-                    self.external(t, model, data)
-                if self.sensors is not None and self.driver is not None:
-                    self.sensors.sample_vio(tick, data)
-                    if self.control_rate.due(tick):
-                        times.append(self._control(tick, t, data))
-                    self.driver.apply(data)
-                if self.firmware is not None and self.firmware_rate.due(tick):
-                    self.firmware.update()
-                mujoco.mj_step(model, data)
-        except SimulationDiverged as exc:
-            result.status, result.error = "failed", str(exc)
-        finally:  # parameter changes last one run only
-            model.geom_friction[:] = friction
-            model.body_mass[:] = masses
+                    self._apply_changes(tick, model)
+                    self._apply_disturbances(t, data)
+                    if self.external is not None:
+                        self.external(t, model, data)
+                    if self.sensors is not None and self.driver is not None:
+                        self.sensors.sample_vio(tick, data)
+                        if self.control_rate.due(tick):
+                            times.append(self._control(tick, t, data))
+                        self.driver.apply(data)
+                    if self.firmware is not None and self.firmware_rate.due(tick):
+                        self.firmware.update()
+                    mujoco.mj_step(model, data)
+            except SimulationDiverged as exc:
+                result.status, result.error = "failed", str(exc)
+            finally:  # parameter changes last one run only
+                model.geom_friction[:] = friction
+                model.body_mass[:] = masses
         result.sim_time = tick / hz
         result.wall_time = time.perf_counter() - start
         result.log = recorder.arrays()
