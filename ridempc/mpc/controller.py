@@ -201,12 +201,14 @@ class LinearMpc:
             )
         self.reference = steady_riding(reference, self.model.rates)
 
-    def problem(self, t: float, x0: Array) -> MpcProblem:
-        """The MPC problem at time ``t`` [s] (since the reference's start) from ``x0``."""
+    def problem(self, t: float, x0: Array, drift: Array | None = None) -> MpcProblem:
+        """The MPC problem at time ``t`` [s] (since the reference's start) from ``x0``,
+        with ``drift`` (nx), an estimated disturbance added to the model's rates over the
+        horizon (:func:`~ridempc.mpc.problem.linearize`), if given."""
         s = self.settings
         x0 = np.asarray(x0, dtype=float).ravel()
         window = self.reference.sample(t, s.horizon, s.dt)
-        dynamics = linearize(self.model, x0, window.inputs, window.parameters, s.dt)
+        dynamics = linearize(self.model, x0, window.inputs, window.parameters, s.dt, drift)
         surfaces = surface_rotations(self.pair, x0)
         index = self.reference.force_index
         g, g_lo, g_hi = friction_pyramids(

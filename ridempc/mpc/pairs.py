@@ -87,6 +87,9 @@ class MpcPair(NamedTuple):
             Hovershoes (velocity-steps seed 0, velocity RMSE 0.1228 at 0, 0.1126 at 0.03,
             0.1102 at 0.06, 0.1085 at 0.1; seed 1 0.1190 -> 0.1070 at 0.06), 0 elsewhere
             (the dog's push-offs start with the board still).
+        roll_observer: :math:`\\beta` of the deck's disturbance-torque estimate
+            (:class:`~ridempc.mpc.roll_observer.RollObserver`) [-], or None for none: 0.3 on
+            the skateboard, None elsewhere (no deck roll).
     """
 
     pair: Pair
@@ -100,6 +103,7 @@ class MpcPair(NamedTuple):
     force_time_constant: float | None = None
     terminal_factor: float = 10.0
     start_speed: float = 0.0
+    roll_observer: float | None = None
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -118,7 +122,7 @@ def _skateboard() -> MpcPair:
     # The library's bound on each force component (skate_problem: twice the weight).
     pair = load_pair(robot.name, "skateboard")
     weight = robot.mass * GRAVITY
-    return MpcPair(pair, robot.feet, surfaces, limits, 2.0 * weight, weight)
+    return MpcPair(pair, robot.feet, surfaces, limits, 2.0 * weight, weight, roll_observer=0.3)
 
 
 def _ride(

@@ -215,6 +215,7 @@ def linearize(
     u_ref: Array,
     p_k: Array,
     dt: float = MPC_STEP,
+    drift: Array | None = None,
 ) -> LinearisedDynamics:
     """Linearise the dynamics at the estimate and discretise them with a zero-order hold.
 
@@ -225,6 +226,9 @@ def linearize(
         u_ref: Reference inputs :math:`\\bar u_k`, N x nu.
         p_k: Mode parameters :math:`p_k`, N x n_p.
         dt: Step :math:`\\Delta t` [s].
+        drift: A constant term :math:`\\Delta f` (nx) added to the rates over the whole
+            horizon, :math:`\\dot x = f + \\Delta f` (an estimated disturbance, in the
+            states' rates' units), discretised with them; None: none.
 
     Returns:
         :math:`A_k, B_k, c_k` of eq. (18) (see the module docstring).
@@ -242,6 +246,8 @@ def linearize(
     if not dt > 0.0:
         raise ValueError(f"linearize: dt must be positive, got {dt}")
     rates_0, a_c, b_c = model.evaluate(x0, u_ref, p_k)
+    if drift is not None:
+        rates_0 = rates_0 + drift
     a_d, phi = zero_order_hold(a_c, dt)
     b_d = phi @ b_c
     g_d = np.einsum("kij,kj->ki", phi, rates_0)

@@ -75,6 +75,7 @@ from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
+    HOLD,
     YAW_RATE_SUFFIXES,
     Manoeuvre,
     ManoeuvreSelector,
@@ -83,6 +84,7 @@ from ridempc.mpc.manoeuvre import (
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.state_map import StateMap, forward_speed
@@ -244,9 +246,16 @@ class MpcRider(Controller):
             if self.shoes is not None
             else ()
         )
-        self._steer_gain = (
-            skateboard_model(loaded).reduced.steer_gain
+        deck = (
+            skateboard_model(loaded).reduced
             if loaded is not None and isinstance(loaded.params, SkateboardParameters)
+            else None
+        )
+        self._steer_gain = deck.steer_gain if deck is not None else None
+        index, gain = self.layout.names, self.pair.roll_observer
+        self.roll_observer = (
+            RollObserver(index["board_roll"], index["board_roll_rate"], deck, gain)
+            if deck is not None and gain is not None and "board_roll_rate" in index
             else None
         )
         self.feet = ReferenceFeet(
@@ -387,7 +396,7 @@ class MpcRider(Controller):
         self._follow_board(mapped, here, turn, now, coasting)
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
-        problem = self.mpc.problem(t_ref, x0)
+        problem = self.mpc.problem(t_ref, x0, self._roll_drift(x0, now, coasting))
         if coasting:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
@@ -435,6 +444,20 @@ class MpcRider(Controller):
             names, rider = self.layout.names, self.layout.rider_states
             self._lean_shift = (key, self.mpc.static_shift(t_ref, names["com_y"], rider))
         return self._lean_shift[1]
+
+    def _roll_drift(self, x0: Array, now: float, coasting: bool) -> Array | None:
+        """The deck's estimated disturbance torque as a drift of the MPC's rates
+        (:mod:`~ridempc.mpc.roll_observer`), in four-leg balancing (holding before a
+        push-off, or coasting after one); None elsewhere, or without a deck roll."""
+        observer = self.roll_observer
+        if observer is None:
+            return None
+        if not (self.manoeuvre.kind == HOLD or coasting):
+            observer.reset()
+            return None
+        share = (now - self._plan_time) / self.mpc.settings.dt
+        self._diagnostics["roll_disturbance"] = observer.update(x0, self._plan, share)
+        return observer.drift(len(x0))
 
     def _unwrapped(self, x0: Array, reference: Array) -> Array:
         """``x0`` with each heading (``*_yaw``, ``*_psi``) [rad] within :math:`\\pi` of the
