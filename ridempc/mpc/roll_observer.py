@@ -34,8 +34,8 @@ with :math:`\\hat\\varphi_j` the estimated roll at MPC tick :math:`j` and
 first two nodes, as the whole-body controller follows it). :math:`K_B` turns a roll error
 into the torque that holds it, and :math:`\\beta` [-] is the share of it taken per tick.
 On the free deck one tick's roll goes 0.18 of the way to a torque's balance, so each
-tick closes :math:`0.18\beta` of the estimate's error: a time constant of 0.55 s at
-:math:`\beta` = 0.3 (0.32 s at 0.5). The estimate is kept only in four-leg balancing
+tick closes :math:`0.18\\beta` of the estimate's error: a time constant of 0.55 s at
+:math:`\\beta` = 0.3 (0.32 s at 0.5). The estimate is kept only in four-leg balancing
 (before a push-off and while coasting), where all four feet stand on the deck and the
 model's contact set is the deck's; it restarts from zero when a push-off ends.
 """
