@@ -6,11 +6,15 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    (:data:`BENCH_SCENARIOS`: a manoeuvre, not standing still, where the QPs are hardest;
    ``scenario`` overrides it) for ``seconds`` of simulated time (seed 0): every MPC
    problem (30 Hz) and every WBC input (estimate and targets, 500 Hz) is kept, and the
-   ride's wall time gives the closed-loop **real-time factor** (simulated over wall time;
+   loop's wall time gives the closed-loop **real-time factor** (simulated over wall time;
    above 1 is faster than real time). The ride's own MPC ticks are timed too (**MPC tick**:
    building the problem, linearisation and discretisation included, and solving it, inside
    the closed loop). A ride that falls early still gives its problems up to the fall; the
-   table says how many.
+   table says how many. The ride's wall time is split into its **budget**, the mean wall
+   time per control tick [ms] (the real-time budget is the tick's 2 ms): the simulation
+   (physics at 1500 Hz, sensors, the board's firmware, the motor drivers, the judge's log)
+   and the rider's estimator, MPC (its 30 Hz ticks spread over the 500 Hz ones), WBC
+   (model, contacts, QP) and the rest of the rider's tick.
 2. **MPC.** The recorded problems are solved again in order by a fresh
    :class:`~ridempc.mpc.qp.MpcQP` (OSQP, built once, updated in place, warm-started):
    median and p99 of the update-and-solve time [ms].
@@ -77,6 +81,7 @@ class PairBench:
     wbc_solve_p99_ms: float = float("nan")
     wbc_failures: int = 0
     ride_status: str = ""
+    budget_ms: dict[str, float] = field(default_factory=dict)
     solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
     wbc_solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
 
@@ -94,9 +99,32 @@ def _scenario_of(pair: str, scenario: str | None) -> str:
     return scenario or BENCH_SCENARIOS.get(pair, "stand-still")
 
 
+BUDGET_PARTS: tuple[str, ...] = ("simulation", "estimator", "mpc", "wbc", "rider_rest")
+
+
+def _budget(result: Any, parts: dict[str, float], mpc_ms: Sequence[float]) -> dict[str, float]:
+    """The ride's mean wall time per control tick [ms], whole (``loop``) and by part
+    (:data:`BUDGET_PARTS`; module docstring), from the loop's wall time [s], the rider's
+    update times [s], the seconds ``parts`` spent in the estimator and the WBC, and the MPC
+    ticks' times [ms]."""
+    ticks = len(result.controller_times)
+    if ticks == 0:
+        return {}
+    rider = float(np.sum(result.controller_times))
+    mpc = 1e-3 * float(np.sum(mpc_ms))
+    spent = {
+        "simulation": result.wall_time - rider,
+        "estimator": parts["estimator"],
+        "mpc": mpc,
+        "wbc": parts["wbc"],
+        "rider_rest": rider - parts["estimator"] - mpc - parts["wbc"],
+    }
+    return {"loop": 1e3 * result.wall_time / ticks} | {k: 1e3 * v / ticks for k, v in spent.items()}
+
+
 def _record(
     robot_name: str, board_name: str, scenario_name: str, seconds: float
-) -> tuple[Any, list, list, Any, float]:
+) -> tuple[Any, list, list, Any, dict[str, float]]:
     from ridempc.boards import load_board
     from ridempc.mpc.rider import MpcRider
     from ridempc.robots import load_robot
@@ -116,18 +144,30 @@ def _record(
     robot = load_robot(robot_name)
     rider = Recording(robot, board_name)
     solve = rider.wbc.solve
+    estimate = rider.estimator.update
+    parts = {"estimator": 0.0, "wbc": 0.0}  # [s] spent in each over the ride
 
     def recording_solve(state: Any, targets: Any) -> Any:
         wbc_inputs.append((state, targets))
-        return solve(state, targets)
+        started = time.perf_counter()
+        try:
+            return solve(state, targets)
+        finally:
+            parts["wbc"] += time.perf_counter() - started
+
+    def timed_estimate(packet: Any) -> Any:
+        started = time.perf_counter()
+        try:
+            return estimate(packet)
+        finally:
+            parts["estimator"] += time.perf_counter() - started
 
     rider.wbc.solve = recording_solve  # type: ignore[method-assign]
+    rider.estimator.update = timed_estimate  # type: ignore[method-assign]
     scenario = resolve_scenario(scenario_name, board_name).with_duration(seconds)
     scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=load_board(board_name))
-    started = time.perf_counter()
     result = Simulation(scene, rider, scenario).run()
-    wall = time.perf_counter() - started
-    return result, problems, wbc_inputs, rider, wall
+    return result, problems, wbc_inputs, rider, _budget(result, parts, rider.mpc_tick_ms)
 
 
 def _as_qpsolvers(
@@ -365,10 +405,12 @@ def bench_pair(
 
     name = f"{robot}-{board}"
     out = PairBench(pair=name, scenario=_scenario_of(name, scenario))
-    result, problems, wbc_inputs, rider, wall = _record(robot, board, out.scenario, seconds)
+    result, problems, wbc_inputs, rider, budget = _record(robot, board, out.scenario, seconds)
+    out.budget_ms = budget
     out.ride_status = "fell" if result.fell else result.status
     out.simulated_s = float(result.sim_time)
-    out.real_time_factor = float(result.sim_time / wall) if wall > 0 else float("nan")
+    loop = result.wall_time  # the loop's own, without building the scene
+    out.real_time_factor = float(result.sim_time / loop) if loop > 0 else float("nan")
     out.mpc_problems, out.wbc_ticks = len(problems), len(wbc_inputs)
     out.mpc_tick_median_ms, out.mpc_tick_p99_ms = _stats([1e-3 * ms for ms in rider.mpc_tick_ms])
     if problems:
@@ -470,9 +512,22 @@ def bench_table(rows: Sequence[PairBench]) -> str:
             f"{_ms(r.wbc_solve_median_ms)} / {_ms(r.wbc_solve_p99_ms)} | "
             f"{_ms(r.real_time_factor)} |"
         )
+    lines += _budget_table(rows)
     for what, table in (("MPC", "solvers"), ("WBC", "wbc_solvers")):
         lines += _solver_table(what, [(r.pair, getattr(r, table)) for r in rows])
     return "\n".join(lines)
+
+
+def _budget_table(rows: Sequence[PairBench]) -> list[str]:
+    """The closed loop's budget: mean wall time per 2 ms control tick [ms], by part."""
+    head = " | ".join(BUDGET_PARTS)
+    lines = ["", f"| pair | mean per control tick [ms]: loop | {head} |"]
+    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS))
+    for r in rows:
+        b = r.budget_ms
+        cells = " | ".join(_ms(b.get(k, float("nan"))) for k in ("loop", *BUDGET_PARTS))
+        lines.append(f"| {r.pair} | {cells} |")
+    return lines
 
 
 def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]]]) -> list[str]:

@@ -93,6 +93,13 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     out = bench_pair("cassie", "segway", seconds=0.2)
     assert out.ride_status == "ok" and out.wbc_ticks == 100
     assert out.wbc_failures == 0
+    # the closed loop's budget: its parts add up to the loop's wall time per tick
+    from ridempc.bench import BUDGET_PARTS
+
+    parts = [out.budget_ms[k] for k in BUDGET_PARTS]
+    assert all(p > 0.0 for p in parts), out.budget_ms
+    assert sum(parts) == pytest.approx(out.budget_ms["loop"], rel=1e-9)
+    assert out.budget_ms["loop"] == pytest.approx(2.0 / out.real_time_factor, rel=1e-6)
     # the same QPs, to DAQP and proxqp: the same optimum (OSQP polished to its active set)
     assert {"osqp", "daqp"} <= set(out.wbc_solvers)
     for name, figures in out.wbc_solvers.items():
