@@ -23,7 +23,11 @@ Every 2 ms (500 Hz) the rider
    :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, each shoe's heading is
    read off its direction of travel where its foot's toe line has crept round on it
    (:mod:`ridempc.mpc.shoe_heading`, at 500 Hz, for the WBC too), and each shoe's heading
-   reference is turned towards its line (:mod:`ridempc.mpc.guidance`);
+   reference is turned towards its line (:mod:`ridempc.mpc.guidance`); on the
+   skateboard, in four-leg balancing, the MPC's deck-roll row carries an integrated
+   estimate of the torque its model misses (:mod:`ridempc.mpc.roll_observer`), and while
+   a foot swings the first step's deck forces are drawn to the last plan's
+   (:mod:`ridempc.mpc.input_rate`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
    the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
