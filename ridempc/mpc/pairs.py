@@ -90,6 +90,13 @@ class MpcPair(NamedTuple):
         roll_observer: :math:`\\beta` of the deck's disturbance-torque estimate
             (:class:`~ridempc.mpc.roll_observer.RollObserver`) [-], or None for none: 0.3 on
             the skateboard, None elsewhere (no deck roll).
+        swing_force_step: While a foot swings and no contact changes, the tolerance of each
+            deck force's change from one solve's first input to the next [N]
+            (:func:`~ridempc.mpc.input_rate.hold_first_input`, :math:`S = 1/\\sigma^2`), or
+            None for none: 10 N on the skateboard, where push-off-1.0's light front foot lost
+            the deck in the last stroke's swing and the ride fell (seeds 0/1 ride through
+            with it; at 10 N in every phase push-off-0.3 seed 1 and push-off-1.0 seed 1
+            fell, at 5 N push-off-1.0 fell at 1.7 s), None elsewhere.
     """
 
     pair: Pair
@@ -104,6 +111,7 @@ class MpcPair(NamedTuple):
     terminal_factor: float = 10.0
     start_speed: float = 0.0
     roll_observer: float | None = None
+    swing_force_step: float | None = None
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -122,7 +130,16 @@ def _skateboard() -> MpcPair:
     # The library's bound on each force component (skate_problem: twice the weight).
     pair = load_pair(robot.name, "skateboard")
     weight = robot.mass * GRAVITY
-    return MpcPair(pair, robot.feet, surfaces, limits, 2.0 * weight, weight, roll_observer=0.3)
+    return MpcPair(
+        pair,
+        robot.feet,
+        surfaces,
+        limits,
+        2.0 * weight,
+        weight,
+        roll_observer=0.3,
+        swing_force_step=10.0,
+    )
 
 
 def _ride(

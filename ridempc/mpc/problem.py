@@ -285,7 +285,8 @@ class MpcProblem:
         state_reference: :math:`x^{ref}_0 \\dots x^{ref}_N`, (N + 1) x nx.
         input_reference: :math:`u^{ref}_k`, N x nu.
         state_weights: Diagonal of :math:`Q` (nx), in [1 / state unit^2].
-        input_weights: Diagonal of :math:`R` (nu), in [1 / input unit^2].
+        input_weights: Diagonal of :math:`R` (nu), in [1 / input unit^2], or one per step
+            (N x nu).
         input_lower: :math:`u^{lo}_k`, N x nu (-inf: unbounded).
         input_upper: :math:`u^{hi}_k`, N x nu (inf: unbounded).
         constraint_matrix: :math:`G_k`, N x m x nu.
@@ -338,7 +339,11 @@ class MpcProblem:
             "state_reference": _shaped("state_reference", self.state_reference, (n + 1, nx)),
             "input_reference": _shaped("input_reference", self.input_reference, (n, nu)),
             "state_weights": _shaped("state_weights", self.state_weights, (nx,)),
-            "input_weights": _shaped("input_weights", self.input_weights, (nu,)),
+            "input_weights": _shaped(
+                "input_weights",
+                self.input_weights,
+                (n, nu) if np.ndim(self.input_weights) == 2 else (nu,),
+            ),
             "terminal_weights": _shaped("terminal_weights", terminal, (nx,)),
             "input_lower": _shaped("input_lower", self.input_lower, (n, nu)),
             "input_upper": _shaped("input_upper", self.input_upper, (n, nu)),

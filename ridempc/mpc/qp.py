@@ -319,7 +319,7 @@ class MpcQP:
                 np.zeros(self.nx),  # x_0 is fixed by its rows
                 np.tile(problem.state_weights, n - 1),
                 problem.final_weights,
-                np.tile(problem.input_weights, n),
+                np.broadcast_to(problem.input_weights, (n, self.nu)).ravel(),
             ]
         )
         return weights * self._scale**2

@@ -23,7 +23,11 @@ Every 2 ms (500 Hz) the rider
    :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, each shoe's heading is
    read off its direction of travel where its foot's toe line has crept round on it
    (:mod:`ridempc.mpc.shoe_heading`, at 500 Hz, for the WBC too), and each shoe's heading
-   reference is turned towards its line (:mod:`ridempc.mpc.guidance`);
+   reference is turned towards its line (:mod:`ridempc.mpc.guidance`); on the
+   skateboard, in four-leg balancing, the MPC's deck-roll row carries an integrated
+   estimate of the torque its model misses (:mod:`ridempc.mpc.roll_observer`), and while
+   a foot swings the first step's deck forces are drawn to the last plan's
+   (:mod:`ridempc.mpc.input_rate`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
    the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
@@ -72,6 +76,7 @@ from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
+from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
@@ -262,6 +267,7 @@ class MpcRider(Controller):
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
         self._support: tuple[Contact, ...] | None = None  # per foot, this MPC step
+        self._contacts: tuple[Contact, ...] = ()  # per library contact, the last MPC step
         self._tick = 0
         self._plan: Plan | None = None
         self._last_problem: MpcProblem | None = None
@@ -417,6 +423,8 @@ class MpcRider(Controller):
             states = self.shoes.shift_reference(states, columns)
             c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
+        problem = self._held_forces(problem)
+        self._contacts = problem.contacts[0]
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem
@@ -444,6 +452,25 @@ class MpcRider(Controller):
             names, rider = self.layout.names, self.layout.rider_states
             self._lean_shift = (key, self.mpc.static_shift(t_ref, names["com_y"], rider))
         return self._lean_shift[1]
+
+    def _held_forces(self, problem: MpcProblem) -> MpcProblem:
+        """While a foot swings and no contact changes from the last tick, the first step's
+        deck forces drawn to the last plan's (:mod:`~ridempc.mpc.input_rate`), with the
+        pair's tolerance :attr:`~ridempc.mpc.pairs.MpcPair.swing_force_step`."""
+        step, contacts = self.pair.swing_force_step, problem.contacts[0]
+        if (
+            step is None
+            or self._plan is None
+            or Contact.SWING not in contacts
+            or self._contacts != contacts
+        ):
+            return problem
+        index = self.mpc.reference.force_index
+        weights = np.zeros(problem.nu)
+        for i, contact in enumerate(contacts):
+            if contact is Contact.BOARD:
+                weights[index[i]] = 1.0 / step**2
+        return hold_first_input(problem, self._plan.first_input, weights)
 
     def _roll_drift(self, x0: Array, now: float, coasting: bool) -> Array | None:
         """The deck's estimated disturbance torque as a drift of the MPC's rates
