@@ -104,9 +104,13 @@ BUDGET_PARTS: tuple[str, ...] = ("simulation", "estimator", "mpc", "wbc", "rider
 
 def _budget(result: Any, parts: dict[str, float], mpc_ms: Sequence[float]) -> dict[str, float]:
     """The ride's mean wall time per control tick [ms], whole (``loop``) and by part
-    (:data:`BUDGET_PARTS`; module docstring), from the loop's wall time [s], the rider's
-    update times [s], the seconds ``parts`` spent in the estimator and the WBC, and the MPC
-    ticks' times [ms]."""
+    (:data:`BUDGET_PARTS`; module docstring).
+
+    Args:
+        result: The ride (its loop's wall time and each rider update's time [s]).
+        parts: Seconds spent in the estimator and in the WBC over the ride.
+        mpc_ms: Each MPC tick's time [ms] (inside the rider's updates).
+    """
     ticks = len(result.controller_times)
     if ticks == 0:
         return {}
