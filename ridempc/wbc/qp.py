@@ -20,10 +20,9 @@ start. A value that falls outside the pattern (a configuration never seen) widen
 pattern and sets the workspace up again (counted in :attr:`WholeBodyQP.setups`), so the
 pattern is a speed-up, never a source of error.
 
-**Tolerance.** ADMM runs to 1e-6 unpolished (:mod:`ridempc.wbc.settings`: polishing, an
-exact solve of the active set, took 18 % of a tick), so the dynamics and contact rows hold to
-~3e-5. Where the settings ask for polishing and it fails (a degenerate active set),
-:meth:`WholeBodyQP._refine` projects the solution onto its active rows instead.
+**Exact equalities.** OSQP's polishing solves the identified active set exactly, so the
+dynamics hold to ~1e-12 though ADMM stops at 1e-4; where polishing fails (a degenerate
+active set), :meth:`WholeBodyQP._refine` projects the solution onto its active rows.
 
 **A second solver.** Where OSQP fails even from a cold start, the same dense problem goes
 to DAQP (an exact dual active-set solver, Arnström et al. 2022), counted in
