@@ -37,7 +37,7 @@ at most 5 ms and a WBC p99 of at most 1 ms.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -126,6 +126,19 @@ def _budget(result: Any, parts: dict[str, float], mpc_ms: Sequence[float]) -> di
     return {"loop": 1e3 * result.wall_time / ticks} | {k: 1e3 * v / ticks for k, v in spent.items()}
 
 
+def _timed(function: Callable[..., Any], spent: dict[str, float], key: str) -> Callable[..., Any]:
+    """``function``, adding the wall time of each call to ``spent[key]`` [s]."""
+
+    def timed(*args: Any) -> Any:
+        started = time.perf_counter()
+        try:
+            return function(*args)
+        finally:
+            spent[key] += time.perf_counter() - started
+
+    return timed
+
+
 def _record(
     robot_name: str, board_name: str, scenario_name: str, seconds: float
 ) -> tuple[Any, list, list, Any, dict[str, float]]:
@@ -147,27 +160,17 @@ def _record(
 
     robot = load_robot(robot_name)
     rider = Recording(robot, board_name)
-    solve = rider.wbc.solve
-    estimate = rider.estimator.update
     parts = {"estimator": 0.0, "wbc": 0.0}  # [s] spent in each over the ride
+    solve = _timed(rider.wbc.solve, parts, "wbc")
 
     def recording_solve(state: Any, targets: Any) -> Any:
         wbc_inputs.append((state, targets))
-        started = time.perf_counter()
-        try:
-            return solve(state, targets)
-        finally:
-            parts["wbc"] += time.perf_counter() - started
-
-    def timed_estimate(packet: Any) -> Any:
-        started = time.perf_counter()
-        try:
-            return estimate(packet)
-        finally:
-            parts["estimator"] += time.perf_counter() - started
+        return solve(state, targets)
 
     rider.wbc.solve = recording_solve  # type: ignore[method-assign]
-    rider.estimator.update = timed_estimate  # type: ignore[method-assign]
+    rider.estimator.update = _timed(  # type: ignore[method-assign]
+        rider.estimator.update, parts, "estimator"
+    )
     scenario = resolve_scenario(scenario_name, board_name).with_duration(seconds)
     scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=load_board(board_name))
     result = Simulation(scene, rider, scenario).run()

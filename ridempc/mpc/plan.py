@@ -36,6 +36,13 @@ class Plan(NamedTuple):
     fallback: bool
     iterations: int = 0
 
+    def first_step_state(self, share: float) -> Array:
+        """The planned state ``share`` [-] of the way through the first step (clipped to
+        [0, 1]), linear between :math:`x_0` and :math:`x_1`: what the 500 Hz ticks follow
+        between solves."""
+        s = min(max(share, 0.0), 1.0)
+        return np.asarray((1.0 - s) * self.states[0] + s * self.states[1])
+
 
 def shift_plan(plan: Plan, status: str, solve_time: float, iterations: int = 0) -> Plan:
     """``plan`` one step later, its last state and input held: the fallback of a failed solve.

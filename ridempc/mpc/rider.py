@@ -596,8 +596,7 @@ class MpcRider(Controller):
         plan = self._plan
         assert plan is not None
         n = self.layout.names
-        share = min(max((now - self._plan_time) * 30.0, 0.0), 1.0)
-        x = (1.0 - share) * plan.states[0] + share * plan.states[1]
+        x = plan.first_step_state((now - self._plan_time) * 30.0)
         frame = self.map.frame
         position = frame.point_to_world(np.array([x[n["com_x"]], x[n["com_y"]], x[n["com_z"]]]))
         velocity = frame.vector_to_world(np.array([x[n["vx"]], x[n["vy"]], x[n["vz"]]]))

@@ -95,8 +95,7 @@ class RollObserver:
             The updated :math:`d` [N m].
         """
         if plan is not None and self._running:
-            s = min(max(share, 0.0), 1.0)
-            predicted = (1.0 - s) * plan.states[0, self.roll] + s * plan.states[1, self.roll]
+            predicted = plan.first_step_state(share)[self.roll]
             self.torque += self.gain * self.deck.roll_stiffness * (x0[self.roll] - predicted)
         self._running = True
         return self.torque

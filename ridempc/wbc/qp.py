@@ -58,9 +58,6 @@ __all__ = ["QpProblem", "QpSolution", "WbcFailed", "WholeBodyQP", "solve_daqp"]
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 ACCEPTED: frozenset[str] = frozenset({"solved", "solved inaccurate"})
-_ACCEPTED_VALUES = frozenset(
-    {osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE}
-)
 DAQP_INFINITY: float = 1e30  # DAQP's bound for a free row
 PATTERN_TOLERANCE: float = 1e-12  # [-] entries dropped from the pattern, over the largest
 
@@ -300,7 +297,7 @@ class WholeBodyQP:
             self._solver = None  # its iterates would warm-start the next tick from garbage
             return self._second_solver(problem, status, start)
         refined = False
-        if not polished and self.settings.get("polishing", False):
+        if not polished:
             x, refined = self._refine(problem, x)
         solution = QpSolution(
             x=x,
@@ -341,7 +338,7 @@ class WholeBodyQP:
     @staticmethod
     def _accepted(result: Any) -> bool:
         """OSQP's status is accepted and its solution finite."""
-        return result.info.status_val in _ACCEPTED_VALUES and bool(np.isfinite(result.x).all())
+        return str(result.info.status) in ACCEPTED and bool(np.all(np.isfinite(result.x)))
 
     def _refine(self, problem: QpProblem, x: Array) -> tuple[Array, bool]:
         """Move an unpolished ADMM solution onto its active set exactly.
