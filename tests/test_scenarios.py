@@ -13,6 +13,7 @@ from ridempc.scenarios import (
     resolve_scenario,
     scenario_applies,
 )
+from ridempc.scenarios.scenario import Command
 
 
 @pytest.mark.parametrize("path", library_files(), ids=lambda p: f"{p.parent.name}/{p.stem}")
@@ -97,6 +98,10 @@ def test_command_timeline_steps_and_ramps(tmp_path: Path) -> None:
     assert scenario.command_at(4.0).velocity == 1.0
     assert scenario.command_at(6.0).velocity == 1.0  # kept when a later event sets other fields
     assert scenario.command_at(6.0).yaw_rate == 0.5
+    for t in (0.0, 2.5, 6.0):  # built unchecked, it is the command a check would build
+        command = scenario.command_at(t)
+        assert command == Command(**command.model_dump())
+        assert command.model_fields_set == set(Command.model_fields)
 
 
 def test_each_skateboard_library_target_has_a_push_off_scenario() -> None:

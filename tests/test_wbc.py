@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import qpsolvers
+import scipy.sparse as sparse
 
 from ridempc.boards import load_board
 from ridempc.boards.board import Board
@@ -53,6 +54,7 @@ from ridempc.wbc import (
 from ridempc.wbc.contacts import platform_rotation
 from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.settings import DEFAULT_OSQP_SETTINGS
+from ridempc.wbc.workspace import OsqpWorkspace
 
 GRAVITY = 9.81
 Springs = Literal["passive", "rigid"]
@@ -363,6 +365,35 @@ def test_persistent_workspace_matches_a_fresh_solve(robot, solver: str) -> None:
             scale = np.maximum(1.0, np.abs(reference))
             assert np.max(np.abs(mine.x - reference) / scale) < 1e-3
     assert wbc.qp.setups == 1  # one workspace, its pattern fixed from the start
+
+
+@pytest.mark.filterwarnings("ignore::PendingDeprecationWarning")
+def test_workspace_driven_directly_matches_osqps_public_methods() -> None:
+    """The compiled solver driven directly gives, bit for bit, what ``osqp.OSQP.update`` and
+    ``solve`` give, warm-started over a run of problems with free (infinite) rows."""
+    rng = np.random.default_rng(11)
+    n, m = 6, 8
+    half = rng.normal(size=(n, n))
+    hessian = sparse.csc_matrix(np.triu(half @ half.T + np.eye(n)))
+    matrix = sparse.csc_matrix(rng.normal(size=(m, n)))
+    lower, upper = -np.ones(m), np.ones(m)
+    lower[0], upper[1] = -np.inf, np.inf
+    direct = OsqpWorkspace(hessian, np.zeros(n), matrix, lower, upper, DEFAULT_OSQP_SETTINGS)
+    public = OsqpWorkspace(hessian, np.zeros(n), matrix, lower, upper, DEFAULT_OSQP_SETTINGS)
+    assert direct.direct
+    public._compiled = None  # the osqp.OSQP methods
+    for _ in range(5):
+        q = rng.normal(size=n)
+        px = hessian.data * (1.0 + 0.1 * rng.random(hessian.nnz))
+        ax = matrix.data * (1.0 + 0.1 * rng.random(matrix.nnz))
+        results = []
+        for workspace in (direct, public):
+            workspace.update(q, lower, upper, px, ax)
+            results.append(workspace.solve())
+        mine, theirs = results
+        assert mine.status == theirs.status == "solved"
+        assert np.array_equal(mine.x, theirs.x) and np.array_equal(mine.y, theirs.y)
+        assert mine.iterations == theirs.iterations and mine.polished == theirs.polished
 
 
 def test_infeasible_qp_is_retried_cold_then_by_daqp_then_raises_wbc_failed() -> None:

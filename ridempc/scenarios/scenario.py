@@ -30,7 +30,9 @@ non-physical values are refused with the field named). Example::
 from __future__ import annotations
 
 import math
+from functools import cached_property
 from pathlib import Path
+from types import MappingProxyType
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -76,6 +78,9 @@ class Command(_Frozen):
     roll: float = 0.0
 
 
+_COMMAND_DEFAULTS: MappingProxyType[str, float] = MappingProxyType(Command().model_dump())
+
+
 class CommandEvent(_Frozen):
     """From time ``t``, set the given command fields (ramped over ``ramp`` seconds)."""
 
@@ -87,6 +92,11 @@ class CommandEvent(_Frozen):
     roll: float | None = None
 
     def fields(self) -> dict[str, float]:
+        return dict(self._fields)
+
+    @cached_property
+    def _fields(self) -> dict[str, float]:
+        """The fields it sets, once (:meth:`Scenario.command_at` reads them every tick)."""
         return {
             k: v for k, v in self.model_dump().items() if k not in ("t", "ramp") and v is not None
         }
@@ -173,12 +183,16 @@ class Scenario(_Frozen):
         )
 
     def command_at(self, t: float) -> Command:
-        """The command in force at time ``t`` [s] (piecewise constant, linear ramps)."""
-        values = Command().model_dump()
+        """The command in force at time ``t`` [s] (piecewise constant, linear ramps).
+
+        Called several times a control tick, it builds the command from the events' checked
+        values without validating them again (``model_construct``).
+        """
+        values = dict(_COMMAND_DEFAULTS)
         for event in self.commands:
             if event.t > t:
                 break
-            for key, target in event.fields().items():
+            for key, target in event._fields.items():
                 if event.ramp > 0.0 and t < event.t + event.ramp:
                     alpha = (t - event.t) / event.ramp
                     values[key] = values[key] + alpha * (target - values[key])
@@ -186,7 +200,7 @@ class Scenario(_Frozen):
                     values[key] = target
         for wave in self.waves:
             values[wave.field] += wave.value(t)
-        return Command(**values)
+        return Command.model_construct(set(values), **values)
 
     def with_duration(self, duration: float) -> Scenario:
         return self.model_copy(update={"duration": duration})

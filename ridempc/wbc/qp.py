@@ -5,7 +5,7 @@
 
 (:mod:`ridempc.wbc.tasks`, :mod:`ridempc.wbc.constraints`). :meth:`WholeBodyQP.build` makes
 the dense matrices (:class:`QpProblem`, testable without a solver); :meth:`WholeBodyQP.solve`
-hands them to one persistent OSQP workspace.
+hands them to one persistent OSQP workspace (:mod:`ridempc.wbc.workspace`).
 
 **Fixed sparsity, dense assembly.** The problem is small (42 variables and 62 rows for the
 quadruped, 56 and 74 for Cassie), so the tasks and constraints are assembled as dense NumPy
@@ -36,11 +36,9 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import daqp
 import numpy as np
-import osqp
 import scipy.sparse as sparse
 from numpy.typing import NDArray
 
@@ -52,6 +50,7 @@ from ridempc.wbc.model import ModelTerms
 from ridempc.wbc.settings import DEFAULT_OSQP_SETTINGS
 from ridempc.wbc.targets import WbcTargets
 from ridempc.wbc.tasks import Task
+from ridempc.wbc.workspace import OsqpResult, OsqpWorkspace
 
 __all__ = ["QpProblem", "QpSolution", "WbcFailed", "WholeBodyQP", "solve_daqp"]
 
@@ -222,7 +221,7 @@ class WholeBodyQP:
         self._a_mask = np.zeros((self.rows, n), dtype=bool)
         self._p: _Pattern | None = None
         self._a: _Pattern | None = None
-        self._solver: osqp.OSQP | None = None
+        self._solver: OsqpWorkspace | None = None
         self.setups = 0
         self.cold_retries = 0
         self.fallbacks = 0
@@ -271,15 +270,15 @@ class WholeBodyQP:
         if warm:
             assert solver is not None and self._p is not None and self._a is not None
             solver.update(
-                q=problem.q,
-                l=problem.l,
-                u=problem.u,
-                Px=self._p.values(problem.P),
-                Ax=self._a.values(problem.A),
+                problem.q,
+                problem.l,
+                problem.u,
+                self._p.values(problem.P),
+                self._a.values(problem.A),
             )
         else:
             solver = self._setup(problem)
-        result = solver.solve(raise_error=False)
+        result = solver.solve()
         accepted = self._accepted(result)
         if warm and not accepted:
             # A warm start (iterates and adapted rho of the last tick) can stall where a
@@ -287,27 +286,23 @@ class WholeBodyQP:
             # warm and solved in 1050 cold. Retry once from scratch.
             self.cold_retries += 1
             solver = self._setup(problem)
-            result = solver.solve(raise_error=False)
+            result = solver.solve()
             accepted = self._accepted(result)
-        info = result.info
-        x = np.array(result.x)
-        status = str(info.status)
-        polished = int(info.status_polish) == 1
         if not accepted:
             self._solver = None  # its iterates would warm-start the next tick from garbage
-            return self._second_solver(problem, status, start)
-        refined = False
-        if not polished:
+            return self._second_solver(problem, result.status, start)
+        x, refined = result.x, False
+        if not result.polished:
             x, refined = self._refine(problem, x)
         solution = QpSolution(
             x=x,
-            y=np.array(result.y),
-            status=status,
-            iterations=int(info.iter),
-            polished=polished,
+            y=result.y,
+            status=result.status,
+            iterations=result.iterations,
+            polished=result.polished,
             refined=refined,
             solve_time=time.perf_counter() - start,
-            osqp_time=float(info.run_time),
+            osqp_time=result.run_time,
         )
         self.last = solution
         return solution
@@ -336,9 +331,9 @@ class WholeBodyQP:
         return solution
 
     @staticmethod
-    def _accepted(result: Any) -> bool:
+    def _accepted(result: OsqpResult) -> bool:
         """OSQP's status is accepted and its solution finite."""
-        return str(result.info.status) in ACCEPTED and bool(np.all(np.isfinite(result.x)))
+        return result.status in ACCEPTED and bool(np.all(np.isfinite(result.x)))
 
     def _refine(self, problem: QpProblem, x: Array) -> tuple[Array, bool]:
         """Move an unpolished ADMM solution onto its active set exactly.
@@ -383,18 +378,17 @@ class WholeBodyQP:
                 return False
         return True
 
-    def _setup(self, problem: QpProblem) -> osqp.OSQP:
+    def _setup(self, problem: QpProblem) -> OsqpWorkspace:
         self.include_pattern(problem)
         self._p = _Pattern(self._p_mask, upper=True)
         self._a = _Pattern(self._a_mask)
-        solver = osqp.OSQP()
-        solver.setup(
+        solver = OsqpWorkspace(
             self._p.csc(problem.P),
             problem.q,
             self._a.csc(problem.A),
             problem.l,
             problem.u,
-            **self.settings,
+            self.settings,
         )
         self._solver = solver
         self.setups += 1
