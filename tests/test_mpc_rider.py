@@ -198,11 +198,13 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
     assert max(after) < 0.1, max(after)  # [m/s]
 
 
-def test_a_push_off_reaches_its_target_and_coasts_on(dog) -> None:
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_push_off_reaches_its_target_and_coasts_on(dog, seed: int) -> None:
     """push-off-0.3: at the end of the library's push-off (2.9 s) the board runs within 10 %
-    of 0.3 m/s (0.276 m/s measured), and the rider then coasts on four legs: the MPC's
-    reference speed is the board's own, the library frame follows the board along its
-    line, and the rider stays up."""
+    of 0.3 m/s (measured 0.301 and 0.318 m/s on seeds 0 and 2; 0.281 and 0.332 before the
+    push-off's speed weights, :mod:`ridempc.mpc.push_weights`), and the rider then coasts
+    on four legs: the MPC's reference speed is the board's own, the library frame follows
+    the board along its line, and the rider stays up."""
     rider = MpcRider(dog, "skateboard")
     scenario = resolve_scenario("push-off-0.3", "skateboard").with_duration(4.0)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
@@ -217,7 +219,7 @@ def test_a_push_off_reaches_its_target_and_coasts_on(dog) -> None:
             coasting.append((now, problem.state_reference[0, n["board_v"]], rider._speed(estimate)))
 
     rider._mpc_tick = recording
-    result = Simulation(scene, rider, scenario).run()
+    result = Simulation(scene, rider, scenario, seed=seed).run()
     assert result.status == "ok", result.fall_reason
     summary = run_metrics(result, scenario, dog)
     assert summary["final_velocity"] == pytest.approx(0.3, rel=0.1)

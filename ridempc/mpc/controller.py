@@ -30,6 +30,7 @@ from ridempc.mpc.manoeuvre import YAW_RATE_SUFFIXES
 from ridempc.mpc.pairs import MpcPair, load_mpc_pair, surface_rotations
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MPC_STEP, LinearModel, MpcProblem, build_linear_model, linearize
+from ridempc.mpc.push_weights import with_push_weights
 from ridempc.mpc.qp import MpcQP, QPStructure
 from ridempc.mpc.reference import MotionReference, select_reference, steady_riding
 from ridempc.mpc.statics import StaticShift, static_shift
@@ -225,7 +226,7 @@ class LinearMpc:
         u_lo, u_hi = force_bounds(index, window.contacts, self.pair.input_limits)
         for i, value in self._fixed:
             u_lo[:, i] = u_hi[:, i] = value
-        return MpcProblem(
+        problem = MpcProblem(
             initial_state=x0,
             A=dynamics.A,
             B=dynamics.B,
@@ -242,6 +243,15 @@ class LinearMpc:
             dt=s.dt,
             terminal_weights=self.terminal_factor * self.state_weights,
             contacts=window.contacts,
+        )
+        pair = self.pair
+        return with_push_weights(
+            problem,
+            self.reference,
+            t,
+            pair.push_tolerances,
+            self.terminal_factor,
+            pair.push_max_target,
         )
 
     def static_shift(self, t: float, changed: int, rider_states: Sequence[int]) -> StaticShift:

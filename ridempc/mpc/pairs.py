@@ -11,8 +11,10 @@ MPC's constraints are the library's. The table :data:`MPC_PAIRS` maps
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Mapping
 from functools import cache, partial
+from types import MappingProxyType
 from typing import NamedTuple
 
 import casadi as ca
@@ -97,6 +99,14 @@ class MpcPair(NamedTuple):
             the deck in the last stroke's swing and the ride fell (seeds 0/1 ride through
             with it; at 10 N in every phase push-off-0.3 seed 1 and push-off-1.0 seed 1
             fell, at 5 N push-off-1.0 fell at 1.7 s), None elsewhere.
+        push_tolerances: Over a push-off, the accepted deviation of these states, by
+            name, in their units (:mod:`~ridempc.mpc.push_weights`): on the skateboard the
+            CoM's speed ``vx`` within 0.0125 m/s and the board's ``board_v`` within
+            0.05 m/s, which brought push-off-0.3's final speed on seeds 0-3 from
+            0.281/0.276/0.332/0.267 to 0.301/0.298/0.318/0.297 m/s and push-off-0.5's from
+            0.488/0.480/0.479/0.487 to 0.499/0.504/0.503/0.494; empty elsewhere (no pushes).
+        push_max_target: The largest push-off target [m/s] the ``push_tolerances`` apply
+            to: 0.5 on the skateboard (above it the roll phase after the push fell).
     """
 
     pair: Pair
@@ -112,6 +122,8 @@ class MpcPair(NamedTuple):
     start_speed: float = 0.0
     roll_observer: float | None = None
     swing_force_step: float | None = None
+    push_tolerances: Mapping[str, float] = MappingProxyType({})
+    push_max_target: float = math.inf
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -139,6 +151,8 @@ def _skateboard() -> MpcPair:
         weight,
         roll_observer=0.3,
         swing_force_step=10.0,
+        push_tolerances=MappingProxyType({"vx": 0.0125, "board_v": 0.05}),
+        push_max_target=0.5,
     )
 
 
