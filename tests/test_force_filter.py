@@ -38,6 +38,6 @@ def test_a_time_constant_that_is_not_positive_is_refused(tau: float) -> None:
 def test_only_the_hovershoes_low_pass_their_forces() -> None:
     """The dog's feet swing (a filter would hold force on a lifted foot); on the Segway
     the same filter quietened Cassie's toes but velocity-steps fell at 15.38 s (seed 0)."""
-    assert load_mpc_pair("cassie", "hovershoes").force_time_constant == pytest.approx(0.084)
+    assert load_mpc_pair("cassie", "hovershoes").force_time_constant == pytest.approx(0.042)
     assert load_mpc_pair("cassie", "segway").force_time_constant is None
     assert load_mpc_pair("cyberdog2", "skateboard").force_time_constant is None

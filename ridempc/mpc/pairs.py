@@ -62,13 +62,20 @@ class MpcPair(NamedTuple):
             (:func:`~ridempc.mpc.friction.friction_pyramids`).
         force_time_constant: Time constant of the low-pass on the forces the whole-body
             QP is given [s] (:class:`~ridempc.mpc.force_filter.ForceFilter`), or None to
-            pass the plan's first input as it is: 0.084 s on the Hovershoes, whose toes and
-            shoes rang at 7-9 Hz on the unfiltered forces (yaw-steps seeds 0/1/2/3: yaw-rate
-            RMSE 0.0617/0.0697/0.0626/fell at 21.87 s -> 0.0431/0.0431/0.0427/0.0414 rad/s;
-            but the circle, seeds 0/1, fell at 17.04/17.50 s instead of 22.69/18.81); None on the
-            Segway, where it quietened the toes too but velocity-steps fell at 15.38 s
-            (seed 0; circle yaw-rate RMSE 0.063 -> 0.071), and on the skateboard, whose
-            dog lifts its feet.
+            pass the plan's first input as it is: 0.042 s on the Hovershoes, whose toes and
+            shoes rang at 7-9 Hz on the unfiltered forces (at 0.084 s, yaw-steps seeds
+            0/1/2/3: yaw-rate RMSE 0.0617/0.0697/0.0626/fell at 21.87 s -> 0.0431/0.0431/
+            0.0427/0.0414 rad/s; but the circle, seeds 0/1, fell at 17.04/17.50 s instead of
+            22.69/18.81). From 0.084 to 0.042 s the filter lags less behind the lean into a
+            speed step: velocity-steps seeds 0-3, velocity RMSE 0.110/0.107/0.105/0.108 ->
+            0.1046/0.1041/0.1032/0.1050 m/s; seed 0 unless stated, yaw-steps yaw-rate RMSE
+            0.0441 -> 0.0437 rad/s (seeds 1, 3: 0.0448 -> 0.0435, 0.0428 -> 0.0416), the
+            circle's 0.0261 -> 0.0205 (seed 1: 0.0284 -> 0.0230; foot-spacing RMSE 0.024 ->
+            0.027 m), push's velocity RMSE 0.0470 -> 0.0464 m/s, offset-start's 0.0108 ->
+            0.0126 (yaw-rate 0.0394 -> 0.0221), wave's 0.0070 -> 0.0071; all ride to their
+            ends. None on the Segway, where it quietened the toes too but velocity-steps
+            fell at 15.38 s (seed 0; circle yaw-rate RMSE 0.063 -> 0.071), and on the
+            skateboard, whose dog lifts its feet.
         terminal_factor: The MPC's terminal weight over its stage weight,
             :math:`Q_N = ` this :math:`\\times Q` [-], standing in for the cost beyond the
             0.4 s horizon: 30 on the Hovershoes, 10 elsewhere. At 10 the Hovershoes' plans
@@ -205,7 +212,7 @@ MPC_PAIRS: dict[str, Callable[[], MpcPair]] = {
         "cassie",
         "hovershoes",
         pyramid="diamond",
-        force_time_constant=0.084,
+        force_time_constant=0.042,
         terminal_factor=30.0,
         start_speed=0.06,
     ),
