@@ -51,6 +51,25 @@ UP: Array = np.array([0.0, 0.0, 1.0])
 UP.flags.writeable = False
 
 
+def _unit_rejection(vector: Array, axis: Array) -> tuple[Array, float]:
+    """``vector`` less its component along the unit ``axis``, normalised, and its norm
+    before that. The dot products in NumPy (they add up with fused multiply-adds, which
+    Python's floats cannot repeat bit for bit), the rest in Python floats: on 3-vectors
+    NumPy's calls cost more than their arithmetic, and the floats round the same."""
+    along = float(axis @ vector)
+    (a, b, c), (u, v, w) = axis.tolist(), vector.tolist()
+    return _normalised(np.array((u - a * along, v - b * along, w - c * along)))
+
+
+def _normalised(vector: Array) -> tuple[Array, float]:
+    """``vector`` over its norm, and the norm (np.linalg.norm's sum, without its wrapper)."""
+    norm = math.sqrt(vector @ vector)
+    if norm == 0.0:  # NumPy's NaN, not Python's ZeroDivisionError
+        return vector / norm, norm
+    x, y, z = vector.tolist()
+    return np.array((x / norm, y / norm, z / norm)), norm
+
+
 def _normal(centred: Array, up_hint: Array) -> tuple[Array, Array | None]:
     """The plane's upward unit normal, from the points less their centroid [m], and the
     unit direction of their line when they lie on one (else None)."""
@@ -62,14 +81,25 @@ def _normal(centred: Array, up_hint: Array) -> tuple[Array, Array | None]:
     second = singular[1] if singular.size > 1 else 0.0
     line = None
     if count >= 3 and second / math.sqrt(count) > COLLINEAR:
-        normal = vt[2]
+        normal, _ = _normalised(vt[2])
     elif count >= 2 and singular[0] > 0.0:
         line = vt[0]
-        normal = up_hint - line * (line @ up_hint)
+        normal, _ = _unit_rejection(up_hint, line)
     else:
-        normal = up_hint.copy()
-    normal /= math.sqrt(normal @ normal)  # np.linalg.norm's sum, without its wrapper
+        normal, _ = _normalised(up_hint)
     return (normal if normal[2] >= 0.0 else -normal), line
+
+
+def _yaw_rate(centred: Array, velocities: Array, mean_velocity: Array, spread: float) -> float:
+    """:math:`\\dot\\psi = \\sum_k (r_k \\times \\dot r_k)_z / \\sum_k \\|r_k\\|_{xy}^2` [rad/s]
+    from the points less their centroid [m], their velocities and mean velocity [m/s] and
+    the spread [m^2]. In Python floats: with at most a few points NumPy's calls cost more
+    than the sum, which adds up in NumPy's order for fewer than 8 terms (one by one)."""
+    mean_x, mean_y = float(mean_velocity[0]), float(mean_velocity[1])
+    moment = 0.0
+    for (x, y, _), (u, w, _) in zip(centred.tolist(), velocities.tolist(), strict=True):
+        moment += x * (w - mean_y) - y * (u - mean_x)
+    return moment / spread
 
 
 def estimate_board(
@@ -101,7 +131,10 @@ def estimate_board(
     velocities = np.asarray(velocities, dtype=float).reshape(-1, 3)
     hint = UP if up_hint is None else np.asarray(up_hint, dtype=float)
     count = len(points)
-    centre = points.sum(axis=0) / count  # np.mean's own sum and division, not its wrapper
+    # the centroid and the mean velocity in one column sum (np.mean's own sum and division,
+    # not its wrapper): each column adds up in the same order as alone
+    means = np.add.reduce(np.concatenate((points, velocities), axis=1)) / count
+    centre, mean_velocity = means[:3], means[3:]
     centred = points - centre
     z_axis, line = _normal(centred, hint)
     heading = forward
@@ -109,25 +142,17 @@ def estimate_board(
         along = line @ forward
         if abs(along) >= FORE_AFT * math.sqrt(forward @ forward):
             heading = line if along > 0.0 else -line
-    x_axis = heading - z_axis * (z_axis @ heading)
-    norm = math.sqrt(x_axis @ x_axis)
+    x_axis, norm = _unit_rejection(heading, z_axis)
     if norm < 1e-6:
         raise ValueError("the rider's forward direction is normal to the board")
-    x_axis /= norm
     y_axis = np.empty(3)
     mujoco.mju_cross(y_axis, z_axis, x_axis)  # np.cross costs 30 us on 3-vectors, this 1
     rotation = np.array((x_axis, y_axis, z_axis)).T
     roll, pitch, yaw = rpy_of_matrix(rotation)
     origin = centre if footprint is None else centre - rotation @ footprint
-    mean_velocity = velocities.sum(axis=0) / count
     r = centred[:, :2]
-    r_dot = (velocities - mean_velocity)[:, :2]
-    spread = float((r**2).sum())
-    yaw_rate = (
-        float((r[:, 0] * r_dot[:, 1] - r[:, 1] * r_dot[:, 0]).sum() / spread)
-        if spread > 1e-6
-        else 0.0
-    )
+    spread = float(np.add.reduce(r * r, axis=None))
+    yaw_rate = _yaw_rate(centred, velocities, mean_velocity, spread) if spread > 1e-6 else 0.0
     return BoardEstimate(
         feet=feet,
         position=origin,

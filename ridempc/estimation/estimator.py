@@ -243,8 +243,9 @@ class StateEstimator:
             leg.H, leg.z, leg.R, gated=leg.gated, gate=self.params.velocity_gate
         )
         self.rejected_feet += rejected
+        # the filter's x as it is: the filter rebinds its mean, never writes into it
         self.history.append(
-            HistoryEntry(packet.time, self.filter.x.copy(), legs.imu_position, legs.imu_velocity)
+            HistoryEntry(packet.time, self.filter.x, legs.imu_position, legs.imu_velocity)
         )
         vio = packet.vio
         if vio is not None and vio.stamp != self._vio_stamp:
@@ -333,24 +334,27 @@ class StateEstimator:
         x = self.filter.x
         base_position = x[:3] - legs.imu_position
         base_velocity = x[3:6] - legs.imu_velocity
-        q = q.copy()
-        v = v.copy()
+        q = q.copy()  # q is also the next tick's loop-closure guess; v is this tick's own
         q[:3] = base_position
         v[:3] = attitude.rotation.T @ base_velocity
-        boards = tuple(
-            self._platform(
-                group,
-                rows,
-                alone,
-                base_position + legs.site_position[rows],
-                base_velocity + legs.site_velocity[rows],
-                attitude.rotation[:, 0],
-                full,
+        boards: tuple[BoardEstimate, ...] = ()
+        if self.platforms:  # every site at once, not per platform
+            site_position = base_position + legs.site_position
+            site_velocity = base_velocity + legs.site_velocity
+            boards = tuple(
+                self._platform(
+                    group,
+                    rows,
+                    alone,
+                    site_position[rows],
+                    site_velocity[rows],
+                    attitude.rotation[:, 0],
+                    full,
+                )
+                for (group, rows, alone), full in zip(
+                    self._board_feet(stance), self._platform_rows, strict=True
+                )
             )
-            for (group, rows, alone), full in zip(
-                self._board_feet(stance), self._platform_rows, strict=True
-            )
-        )
         return EstimatedState(
             time=time,
             base_position=base_position,

@@ -27,6 +27,37 @@ __all__ = ["LinearKalmanFilter"]
 Array = NDArray[np.float64]
 
 
+def _normalised_innovations(blocks: Array, innovations: Array) -> list[float]:
+    """:math:`y_g^\\top S_{gg}^{-1} y_g` of each group, from its block :math:`S_{gg}`
+    [groups x rows x rows] and its innovation :math:`y_g` [groups x rows].
+
+    For 3-row groups (a foot's velocity) by Cramer's rule in Python floats,
+    :math:`y^\\top \\mathrm{adj}(S)\\, y / \\det S` with :math:`S` symmetric: about 1 us
+    for two feet where ``np.linalg.solve``'s stacked call and its wrapper took 5. It
+    agrees with an LU solve to rounding, and decides only the outlier test (the same feet
+    rejected on the recorded rides of the three pairs).
+    """
+    if blocks.shape[1:] != (3, 3):
+        whitened = np.linalg.solve(blocks, innovations[..., None])[..., 0]
+        return [float(value) for value in (innovations * whitened).sum(axis=1)]
+    values = []
+    for ((a, b, c), (_, d, e), (_, _, f)), (u, v, w) in zip(
+        blocks.tolist(), innovations.tolist(), strict=True
+    ):
+        # the adjugate's upper triangle (S symmetric: only its upper triangle is read)
+        adj_aa, adj_ab, adj_ac = d * f - e * e, c * e - b * f, b * e - c * d
+        adj_bb, adj_bc, adj_cc = a * f - c * c, b * c - a * e, a * d - b * b
+        determinant = a * adj_aa + b * adj_ab + c * adj_ac
+        quadratic = (
+            adj_aa * u * u
+            + adj_bb * v * v
+            + adj_cc * w * w
+            + 2.0 * (adj_ab * u * v + adj_ac * u * w + adj_bc * v * w)
+        )
+        values.append(quadratic / determinant)
+    return values
+
+
 @dataclass
 class LinearKalmanFilter:
     """Mean and covariance of a Gaussian state.
@@ -74,9 +105,7 @@ class LinearKalmanFilter:
         rejected = 0
         if gated is not None and gated.size:
             blocks = S[gated[:, :, None], gated[:, None, :]]
-            innovations = y[gated]
-            whitened = np.linalg.solve(blocks, innovations[..., None])[..., 0]
-            outliers = (innovations * whitened).sum(axis=1) > gate
+            outliers = np.array(_normalised_innovations(blocks, y[gated])) > gate
             rejected = int(np.count_nonzero(outliers))
             if rejected:
                 keep = np.ones(y.size, dtype=bool)

@@ -60,20 +60,31 @@ class LegReading:
     Attributes:
         foot_position: :math:`d_i` [m], shape (feet, 3).
         foot_velocity: :math:`w_i` [m/s], shape (feet, 3).
-        foot_jacobian: :math:`J_i` [m / rad], shape (feet, 3, nv).
         site_position: Every contact site, shape (sites, 3) [m], ``site_foot`` order.
         site_velocity: Their velocities, shape (sites, 3) [m/s].
         imu_position: :math:`d_S` [m].
         imu_velocity: :math:`w_S` [m/s].
+        site_jacobian: Every contact site's world-aligned linear Jacobian [m / rad], shape
+            (sites, 3, nv).
+        site_mean: Averages sites into feet [feet x sites].
     """
 
     foot_position: Array
     foot_velocity: Array
-    foot_jacobian: Array
     site_position: Array
     site_velocity: Array
     imu_position: Array
     imu_velocity: Array
+    site_jacobian: Array
+    site_mean: Array
+
+    @cached_property
+    def foot_jacobian(self) -> Array:
+        """:math:`J_i` [m / rad], shape (feet, 3, nv): only the torque contact signal
+        reads it, so it is averaged when first asked for."""
+        sites, nv = self.site_jacobian.shape[0], self.site_jacobian.shape[2]
+        jacobian = self.site_mean @ self.site_jacobian.reshape(sites, -1)
+        return jacobian.reshape(self.site_mean.shape[0], 3, nv)
 
 
 @dataclass(frozen=True)
@@ -140,16 +151,15 @@ class LegKinematics:
             jacobians[k] = pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3]
         velocities = jacobians @ v
         sites = slice(0, len(frames) - 1)
-        jacobian = self._site_mean @ jacobians[sites].reshape(len(frames) - 1, -1)
-        jacobian = jacobian.reshape(len(self.feet), 3, model.nv)
         return LegReading(
             foot_position=self._site_mean @ points[sites],
             foot_velocity=self._site_mean @ velocities[sites],
-            foot_jacobian=jacobian,
             site_position=points[sites],
             site_velocity=velocities[sites],
             imu_position=points[-1],
             imu_velocity=velocities[-1],
+            site_jacobian=jacobians[sites],
+            site_mean=self._site_mean,
         )
 
     @cached_property

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
@@ -155,6 +156,9 @@ class LoopClosure:
         return q, v
 
     def _pseudo_inverse(self, jacobian_u: Array) -> Array:
-        gram = jacobian_u @ jacobian_u.T
-        gram.flat[:: gram.shape[0] + 1] += self.damping
-        return solve(gram, jacobian_u).T
+        return solve(jacobian_u @ jacobian_u.T + self._ridge, jacobian_u).T
+
+    @cached_property
+    def _ridge(self) -> Array:
+        """:math:`\\lambda I` [m^2], added to the Gram matrix (its zeros add exactly)."""
+        return self.damping * np.eye(3 * len(self.pairs))
