@@ -114,6 +114,11 @@ class MpcPair(NamedTuple):
             0.488/0.480/0.479/0.487 to 0.499/0.504/0.503/0.494; empty elsewhere (no pushes).
         push_max_target: The largest push-off target [m/s] the ``push_tolerances`` apply
             to: 0.5 on the skateboard (above it the roll phase after the push fell).
+        stance_roll: :math:`s` of the deck roll's stance limit
+            (:class:`~ridempc.mpc.stance.StanceLimit`), the estimated centre-of-mass
+            offset per radian of deck roll [m/rad], or None for no limit: 0.42 on the
+            skateboard (push-off-1.0 seed 0 measured 0.40-0.44 at the roll wave's 0.1 rad),
+            None elsewhere.
     """
 
     pair: Pair
@@ -131,6 +136,7 @@ class MpcPair(NamedTuple):
     swing_force_step: float | None = None
     push_tolerances: Mapping[str, float] = MappingProxyType({})
     push_max_target: float = math.inf
+    stance_roll: float | None = None
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -160,6 +166,7 @@ def _skateboard() -> MpcPair:
         swing_force_step=10.0,
         push_tolerances=MappingProxyType({"vx": 0.0125, "board_v": 0.05}),
         push_max_target=0.5,
+        stance_roll=0.42,
     )
 
 

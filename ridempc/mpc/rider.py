@@ -25,7 +25,9 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.shoe_heading`, at 500 Hz, for the WBC too), and each shoe's heading
    reference is turned towards its line (:mod:`ridempc.mpc.guidance`); on the
    skateboard, in four-leg balancing, the MPC's deck-roll row carries an integrated
-   estimate of the torque its model misses (:mod:`ridempc.mpc.roll_observer`), and while
+   estimate of the torque its model misses (:mod:`ridempc.mpc.roll_observer`), held while
+   the feet of one side are off the deck or at their least force, the commanded roll is
+   held to what the feet's estimated stance can hold (:mod:`ridempc.mpc.stance`), and while
    a foot swings the first step's deck forces are drawn to the last plan's
    (:mod:`ridempc.mpc.input_rate`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
@@ -92,6 +94,7 @@ from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
+from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
@@ -263,6 +266,11 @@ class MpcRider(Controller):
             if deck is not None and gain is not None and "board_roll_rate" in index
             else None
         )
+        self.stance = (
+            StanceLimit(self.pair.stance_roll)
+            if self.roll_observer is not None and self.pair.stance_roll is not None
+            else None
+        )
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -395,14 +403,16 @@ class MpcRider(Controller):
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
-        turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
+        balancing = self.manoeuvre.kind == HOLD or coasting
+        roll = self._stance_roll(roll, estimate, now, balancing)
+        turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
         self._follow_board(mapped, here, turn, now, coasting)
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
-        problem = self.mpc.problem(t_ref, x0, self._roll_drift(x0, now, coasting))
+        problem = self.mpc.problem(t_ref, x0, self._roll_drift(x0, now, balancing, estimate))
         if coasting:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
@@ -472,19 +482,74 @@ class MpcRider(Controller):
                 weights[index[i]] = 1.0 / step**2
         return hold_first_input(problem, self._plan.first_input, weights)
 
-    def _roll_drift(self, x0: Array, now: float, coasting: bool) -> Array | None:
+    def _roll_drift(
+        self, x0: Array, now: float, balancing: bool, estimate: EstimatedState
+    ) -> Array | None:
         """The deck's estimated disturbance torque as a drift of the MPC's rates
         (:mod:`~ridempc.mpc.roll_observer`), in four-leg balancing (holding before a
-        push-off, or coasting after one); None elsewhere, or without a deck roll."""
+        push-off, or coasting after one); None elsewhere, or without a deck roll. Held,
+        not integrated, while the feet of one side are off the deck or both planned at
+        the least force: two feet on one fore-aft line do not see the deck's roll (push-off-1.0
+        seed 5 read 0.002 rad of a 0.07-0.08 rad roll, and the estimate wound up to -5 N m
+        in 0.5 s)."""
         observer = self.roll_observer
         if observer is None:
             return None
-        if not (self.manoeuvre.kind == HOLD or coasting):
+        if not balancing:
             observer.reset()
             return None
         share = (now - self._plan_time) / self.mpc.settings.dt
-        self._diagnostics["roll_disturbance"] = observer.update(x0, self._plan, share)
+        hold = self._one_side_light(estimate)
+        self._diagnostics["roll_disturbance"] = observer.update(x0, self._plan, share, hold)
         return observer.drift(len(x0))
+
+    def _least_force(self) -> float:
+        """The MPC's least force of a foot on the deck [N]."""
+        count = len(self.mpc.reference.force_index)
+        return self.mpc.reference.min_board_share * self.pair.weight / count
+
+    def _one_side_light(self, estimate: EstimatedState) -> bool:
+        """Whether both feet of one side (left or right of the deck's centre line, by their
+        estimated places) are off the deck or planned within 1 N of the least force."""
+        board, plan = estimate.board, self._plan
+        if board is None or plan is None or len(estimate.foot_position) != 4:
+            return False
+        index = self.mpc.reference.force_index
+        if len(index) != 4:
+            return False
+        light = np.asarray(estimate.contact, dtype=bool).copy()
+        light = ~light | (plan.first_input[index[:, 2]] <= self._least_force() + 1.0)
+        c, s = math.cos(board.yaw), math.sin(board.yaw)
+        across = -s * estimate.foot_position[:, 0] + c * estimate.foot_position[:, 1]
+        order = np.argsort(across)
+        return bool(light[order[:2]].all() or light[order[2:]].all())
+
+    def _stance_roll(
+        self, roll: Array, estimate: EstimatedState, now: float, balancing: bool
+    ) -> Array:
+        """The commanded deck roll held within what the stance can hold
+        (:mod:`~ridempc.mpc.stance`), in four-leg balancing, from the four feet's estimated
+        places (the last bounds while one is off the deck); as commanded elsewhere."""
+        limit, board = self.stance, estimate.board
+        if limit is None or board is None:
+            return roll
+        if not balancing:
+            limit.reset()
+            return roll
+        feet = np.asarray(estimate.foot_position, dtype=float)
+        if len(feet) != 4 or not np.all(estimate.contact) or self._plan is None:
+            return np.clip(roll, *limit.last)
+        com = self.map.com(estimate)
+        c, s = math.cos(board.yaw), math.sin(board.yaw)
+        to_deck = np.array([[c, s], [-s, c]])
+        centre = feet[:, :2].mean(axis=0)
+        places = (feet[:, :2] - centre) @ to_deck.T
+        offset = to_deck @ (com[:2] - centre)
+        far_share = 2.0 * self._least_force() / self.pair.weight
+        dt = now - self._plan_time
+        low, high = limit.bounds(places, offset, float(board.roll), dt, far_share)
+        self._diagnostics.update(stance_low=low, stance_high=high)
+        return np.clip(roll, low, high)
 
     def _unwrapped(self, x0: Array, reference: Array) -> Array:
         """``x0`` with each heading (``*_yaw``, ``*_psi``) [rad] within :math:`\\pi` of the

@@ -83,18 +83,19 @@ class RollObserver:
         """Forget the estimate (a push-off, where the model's contacts are not the deck's)."""
         self.torque, self._running = 0.0, False
 
-    def update(self, x0: Array, plan: Plan | None, share: float) -> float:
+    def update(self, x0: Array, plan: Plan | None, share: float, hold: bool = False) -> float:
         """Integrate the roll's prediction error at this tick.
 
         Args:
             x0: The estimated state at this MPC tick.
             plan: The last plan, solved with the estimate in force then (None: none yet).
             share: How far this tick lies between the plan's first two nodes, in steps [-].
+            hold: Keep the estimate as it is (the roll estimate is not to be trusted).
 
         Returns:
             The updated :math:`d` [N m].
         """
-        if plan is not None and self._running:
+        if plan is not None and self._running and not hold:
             predicted = plan.first_step_state(share)[self.roll]
             self.torque += self.gain * self.deck.roll_stiffness * (x0[self.roll] - predicted)
         self._running = True

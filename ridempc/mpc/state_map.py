@@ -245,6 +245,10 @@ class StateMap:
                 x[i] = self._board_value(str(key), estimate.boards, estimate.time)
         return x
 
+    def com(self, estimate: EstimatedState) -> Array:
+        """The centre of mass in the world [m]."""
+        return np.array(pin.centerOfMass(self.robot.model, self.data, estimate.q))
+
     def rider_speed(self, estimate: EstimatedState) -> float:
         """The centre of mass's speed along platform 0's heading (the base's heading without
         a board) [m/s]: :math:`\\dot c_{CoM} \\cdot (\\cos\\psi, \\sin\\psi)`."""
