@@ -254,6 +254,21 @@ def _deck_foot_drift(scene, log, sites: tuple[str, ...], until: float = np.inf) 
     return drift
 
 
+def test_a_stance_with_a_foot_landed_inward_rides_a_cut_roll_wave(dog) -> None:
+    """push-off-1.0, seed 5: after the fourth stroke the front-right foot lands 57 mm
+    inward, and the roll wave's +0.1 rad (from 8.0 s) would carry the centre of mass past
+    the right feet's line (it fell at 9.14 s before :mod:`ridempc.mpc.stance`). With the
+    roll held to what the stance can hold, the dog rides through the wave's first crest
+    and trough, the bound below the commanded 0.1 rad."""
+    rider = MpcRider(dog, "skateboard")
+    scenario = resolve_scenario("push-off-1.0", "skateboard").with_duration(10.5)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    result = Simulation(scene, rider, scenario, seed=5).run()
+    assert result.status == "ok", result.fall_reason
+    assert not result.fell and rider.summary().get("safe_hold") is None
+    assert rider.stance is not None and rider.stance.last[1] < 0.1  # the wave was cut
+
+
 def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     """Cassie's motor PD follows the WBC at a tenth of its gains (``tracking_gain_scale``);
     with the MPC she then stands on the Hovershoes (at full gains the stiff PD overrode the
