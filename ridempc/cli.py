@@ -84,6 +84,11 @@ def _parser() -> argparse.ArgumentParser:
         help="scenario recorded for every pair (default: each pair's manoeuvre, "
         "push-off-0.5 on the skateboard, velocity-steps for Cassie)",
     )
+    bench.add_argument(
+        "--wbc-solver",
+        default="osqp",
+        help="the whole-body QP's solver in the ride and its timing: osqp (default) or daqp",
+    )
     bench.add_argument("--json", type=Path, default=None, help="also write the results here")
 
     board = commands.add_parser("board", help="board tools")
@@ -160,7 +165,13 @@ def _bench(args: argparse.Namespace) -> int:
     if not args.seconds > 0.0:
         raise ConfigError(f"--seconds {args.seconds}: must be positive")
     pairs = [p.strip() for p in args.pairs.split(",")] if args.pairs else None
-    bench(pairs, seconds=args.seconds, json_path=args.json, scenario=args.scenario)
+    bench(
+        pairs,
+        seconds=args.seconds,
+        json_path=args.json,
+        scenario=args.scenario,
+        wbc_solver=args.wbc_solver,
+    )
     return 0
 
 

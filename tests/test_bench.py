@@ -82,6 +82,19 @@ def test_bad_input_is_refused(capsys) -> None:
     assert "no-such-scenario" in capsys.readouterr().err
     assert main(["bench", "--pairs", "cassie-segway", "--scenario", "push-off-0.5"]) == 2
     assert "push-off-0.5" in capsys.readouterr().err
+    assert main(["bench", "--wbc-solver", "qpoases"]) == 2
+    assert "whole-body QP solver 'qpoases' (valid: daqp, osqp)" in capsys.readouterr().err
+
+
+def test_the_closed_loop_can_ride_on_daqp() -> None:
+    """``--wbc-solver daqp``: the ride's whole-body QPs and their timing go to DAQP alone,
+    the ride stays up, and no comparison against OSQP's workspace is made."""
+    from ridempc.bench import bench_pair
+
+    out = bench_pair("cassie", "segway", seconds=0.2, wbc_solver="daqp")
+    assert out.ride_status == "ok" and out.wbc_ticks == 100 and out.wbc_failures == 0
+    assert out.wbc_solver == "daqp" and out.wbc_solvers == {}
+    assert out.wbc_solve_median_ms > 0.0 and out.real_time_factor > 0.0
 
 
 def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:

@@ -396,6 +396,37 @@ def test_workspace_driven_directly_matches_osqps_public_methods() -> None:
         assert mine.iterations == theirs.iterations and mine.polished == theirs.polished
 
 
+def test_daqp_as_the_solver_finds_osqps_polished_optimum(robot) -> None:
+    """``WbcSettings(solver="daqp")``: each problem straight to DAQP (no OSQP workspace),
+    the same optimum as OSQP's polished one; an unknown solver is refused by name."""
+    osqp_wbc = WholeBodyController(robot)
+    daqp_wbc = WholeBodyController(robot, WbcSettings(solver="daqp"))
+    estimator = StateEstimator(robot, pinocchio=osqp_wbc.model.pinocchio)
+    q, v = _standing(robot, estimator, np.random.default_rng(9))
+    contact = np.ones(len(osqp_wbc.foot_names), dtype=bool)
+    for wbc in (osqp_wbc, daqp_wbc):
+        wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, contact))
+    problem = daqp_wbc.last_problem
+    assert problem is not None and daqp_wbc.last_solution is not None
+    assert daqp_wbc.last_solution.status == "solved by daqp"
+    assert daqp_wbc.qp.setups == 0 and daqp_wbc.qp.fallbacks == 0
+    x, reference = daqp_wbc.last_solution.x, osqp_wbc.qp.solve(problem).x
+    assert _cost(problem, x) == pytest.approx(_cost(problem, reference), rel=1e-6, abs=1e-8)
+    with pytest.raises(ConfigError, match="'solver': unknown 'qpoases' \\(valid: daqp, osqp\\)"):
+        WbcSettings(solver="qpoases")
+
+
+def test_daqp_as_the_solver_fails_with_its_own_flag() -> None:
+    robot = load_robot("cyberdog2")
+    settings = WbcSettings(min_normal_force=2000.0, max_normal_force=100, solver="daqp")
+    wbc = WholeBodyController(robot, settings)
+    estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
+    q, v = _standing(robot, estimator, np.random.default_rng(3))
+    with pytest.raises(WbcFailed, match="whole-body QP failed: DAQP exit flag -") as info:
+        wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool)))
+    assert "OSQP" not in str(info.value)
+
+
 def test_infeasible_qp_is_retried_cold_then_by_daqp_then_raises_wbc_failed() -> None:
     robot = load_robot("cyberdog2")
     # 2 kN on every foot cannot be held with 12 N m motors

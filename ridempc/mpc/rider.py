@@ -164,15 +164,23 @@ class MpcRider(Controller):
         robot: The rider.
         board: The board's name; the pair needs an MPC library.
         settings: MPC settings.
+        wbc_solver: The whole-body QP's solver (:data:`~ridempc.wbc.settings.SOLVERS`):
+            ``osqp``, the product's, or ``daqp`` to measure the choice.
 
     Raises:
         UnknownNameError: No MPC for this robot-board pair.
-        ConfigError: Its library is missing or corrupt.
+        ConfigError: Its library is missing or corrupt, or an unknown ``wbc_solver``.
     """
 
     rate_hz = 500.0
 
-    def __init__(self, robot: Robot, board: str, settings: MpcSettings | None = None) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        board: str,
+        settings: MpcSettings | None = None,
+        wbc_solver: str = "osqp",
+    ) -> None:
         super().__init__(robot, board)
         from ridempc.boards import load_board
 
@@ -227,6 +235,7 @@ class MpcRider(Controller):
             springs="rigid" if sprung else "passive",
             force_weight=robot.params.wbc_force_weight,
             pyramid=self.pair.pyramid,
+            solver=wbc_solver,
         )
         self.wbc = WholeBodyController(
             robot,

@@ -132,7 +132,11 @@ class WholeBodyController:
                 f"{len(robot.motors)} motors"
             )
         self.qp = WholeBodyQP(
-            self.model.layout, self._tasks(), self._constraints(), self.settings.osqp
+            self.model.layout,
+            self._tasks(),
+            self._constraints(),
+            self.settings.osqp,
+            self.settings.solver,
         )
         for problem in self._probe_problems(stand):
             self.qp.include_pattern(problem)

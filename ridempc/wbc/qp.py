@@ -29,6 +29,10 @@ to DAQP (an exact dual active-set solver, Arnström et al. 2022), counted in
 :attr:`WholeBodyQP.fallbacks`. ADMM converges slowly on an ill-conditioned :math:`P`: the
 dog's QP in a push-off, with eigenvalues from 1e-5 to 100, ran out of 2000 iterations
 warm and cold, and DAQP solved it to 1e-12 in 0.2 ms.
+
+**Or DAQP alone.** With ``solver="daqp"`` (:attr:`WbcSettings.solver
+<ridempc.wbc.settings.WbcSettings>`) every problem goes straight to DAQP, so that
+``ridempc bench --wbc-solver daqp`` measures the choice of OSQP in the closed loop.
 """
 
 from __future__ import annotations
@@ -59,6 +63,7 @@ Index = NDArray[np.int64]
 ACCEPTED: frozenset[str] = frozenset({"solved", "solved inaccurate"})
 DAQP_INFINITY: float = 1e30  # DAQP's bound for a free row
 PATTERN_TOLERANCE: float = 1e-12  # [-] entries dropped from the pattern, over the largest
+DAQP_ONLY: str = "daqp"  # the status of a failure where DAQP was the solver
 
 
 @dataclass(frozen=True)
@@ -154,10 +159,13 @@ class WbcFailed(RidempcError, RuntimeError):
         self.status = status
         self.problem = problem
         self.daqp_flag = daqp_flag
-        second = "" if daqp_flag is None else f", DAQP exit flag {daqp_flag}"
+        if status == DAQP_ONLY:  # DAQP was the solver, not OSQP's second
+            what = f"DAQP exit flag {daqp_flag}"
+        else:
+            second = "" if daqp_flag is None else f", DAQP exit flag {daqp_flag}"
+            what = f"OSQP status '{status}' (accepted: {', '.join(sorted(ACCEPTED))}){second}"
         super().__init__(
-            f"whole-body QP failed: OSQP status '{status}' "
-            f"(accepted: {', '.join(sorted(ACCEPTED))}){second}; {problem.A.shape[0]} rows, "
+            f"whole-body QP failed: {what}; {problem.A.shape[0]} rows, "
             f"{problem.A.shape[1]} variables"
         )
 
@@ -195,6 +203,8 @@ class WholeBodyQP:
         tasks: The objective's terms.
         constraints: The constraint blocks.
         settings: OSQP settings (``DEFAULT_OSQP_SETTINGS`` where not given).
+        solver: ``osqp`` (module docstring), or ``daqp``: each problem straight to DAQP,
+            no OSQP workspace (:data:`~ridempc.wbc.settings.SOLVERS`).
 
     Attributes:
         setups: OSQP workspace set-ups so far (one at the first solve, one more each time
@@ -210,8 +220,10 @@ class WholeBodyQP:
         tasks: Sequence[Task],
         constraints: Sequence[Constraint],
         settings: Mapping[str, float | int | bool] | None = None,
+        solver: str = "osqp",
     ) -> None:
         self.layout = layout
+        self.solver = solver
         self.tasks = tuple(tasks)
         self.constraints = tuple(c for c in constraints if c.rows > 0)
         self.settings = {**DEFAULT_OSQP_SETTINGS, **(settings or {})}
@@ -265,6 +277,8 @@ class WholeBodyQP:
                 and DAQP finds no solution either.
         """
         start = time.perf_counter()
+        if self.solver == DAQP_ONLY:
+            return self._daqp(problem, start)
         solver = self._solver
         warm = solver is not None and self._fits(problem)
         if warm:
@@ -313,10 +327,20 @@ class WholeBodyQP:
         Raises:
             WbcFailed: DAQP finds no finite solution either (with OSQP's ``status``).
         """
+        solution = self._daqp(problem, start, status)
+        self.fallbacks += 1
+        return solution
+
+    def _daqp(self, problem: QpProblem, start: float, status: str = DAQP_ONLY) -> QpSolution:
+        """DAQP on the dense problem, as the solver or as OSQP's second.
+
+        Raises:
+            WbcFailed: DAQP finds no finite solution (with OSQP's ``status`` if it was the
+                second).
+        """
         x, flag, iterations, duals = solve_daqp(problem)
         if flag < 1 or not np.all(np.isfinite(x)):
             raise WbcFailed(status, problem, daqp_flag=flag)
-        self.fallbacks += 1
         solution = QpSolution(
             x=x,
             y=duals,
