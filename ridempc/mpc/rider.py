@@ -157,6 +157,12 @@ def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
     return (shoe,) * shoes.n_platforms
 
 
+def _to_deck(yaw: float, planar: Array) -> Array:
+    """Horizontal vectors [m] (..., 2), world axes, in the deck's (along, across) axes."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.asarray(planar, dtype=float) @ np.array([[c, -s], [s, c]])
+
+
 class MpcRider(Controller):
     """MPC at 30 Hz over the robot and its board, whole-body QP at 500 Hz.
 
@@ -526,10 +532,9 @@ class MpcRider(Controller):
         index = self.mpc.reference.force_index
         if len(index) != 4:
             return False
-        light = np.asarray(estimate.contact, dtype=bool).copy()
-        light = ~light | (plan.first_input[index[:, 2]] <= self._least_force() + 1.0)
-        c, s = math.cos(board.yaw), math.sin(board.yaw)
-        across = -s * estimate.foot_position[:, 0] + c * estimate.foot_position[:, 1]
+        contact = np.asarray(estimate.contact, dtype=bool)
+        light = ~contact | (plan.first_input[index[:, 2]] <= self._least_force() + 1.0)
+        across = _to_deck(board.yaw, estimate.foot_position[:, :2])[:, 1]
         order = np.argsort(across)
         return bool(light[order[:2]].all() or light[order[2:]].all())
 
@@ -549,11 +554,9 @@ class MpcRider(Controller):
         if len(feet) != 4 or not np.all(estimate.contact) or self._plan is None:
             return np.clip(roll, *limit.last)
         com = self.map.com(estimate)
-        c, s = math.cos(board.yaw), math.sin(board.yaw)
-        to_deck = np.array([[c, s], [-s, c]])
         centre = feet[:, :2].mean(axis=0)
-        places = (feet[:, :2] - centre) @ to_deck.T
-        offset = to_deck @ (com[:2] - centre)
+        places = _to_deck(board.yaw, feet[:, :2] - centre)
+        offset = _to_deck(board.yaw, com[:2] - centre)
         far_share = 2.0 * self._least_force() / self.pair.weight
         dt = now - self._plan_time
         low, high = limit.bounds(places, offset, float(board.roll), dt, far_share)

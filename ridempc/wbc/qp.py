@@ -63,7 +63,6 @@ Index = NDArray[np.int64]
 ACCEPTED: frozenset[str] = frozenset({"solved", "solved inaccurate"})
 DAQP_INFINITY: float = 1e30  # DAQP's bound for a free row
 PATTERN_TOLERANCE: float = 1e-12  # [-] entries dropped from the pattern, over the largest
-DAQP_ONLY: str = "daqp"  # the status of a failure where DAQP was the solver
 
 
 @dataclass(frozen=True)
@@ -150,16 +149,19 @@ class WbcFailed(RidempcError, RuntimeError):
     """The whole-body QP has no acceptable solution.
 
     Attributes:
-        status: OSQP's status (e.g. ``primal infeasible``, ``maximum iterations reached``).
+        status: OSQP's status (e.g. ``primal infeasible``, ``maximum iterations reached``),
+            or None where DAQP was the solver (``solver="daqp"``).
         problem: The problem that failed.
         daqp_flag: DAQP's exit flag, if it was tried (negative: infeasible or failed).
     """
 
-    def __init__(self, status: str, problem: QpProblem, daqp_flag: int | None = None) -> None:
+    def __init__(
+        self, status: str | None, problem: QpProblem, daqp_flag: int | None = None
+    ) -> None:
         self.status = status
         self.problem = problem
         self.daqp_flag = daqp_flag
-        if status == DAQP_ONLY:  # DAQP was the solver, not OSQP's second
+        if status is None:  # DAQP was the solver, not OSQP's second
             what = f"DAQP exit flag {daqp_flag}"
         else:
             second = "" if daqp_flag is None else f", DAQP exit flag {daqp_flag}"
@@ -277,7 +279,7 @@ class WholeBodyQP:
                 and DAQP finds no solution either.
         """
         start = time.perf_counter()
-        if self.solver == DAQP_ONLY:
+        if self.solver == "daqp":
             return self._daqp(problem, start)
         solver = self._solver
         warm = solver is not None and self._fits(problem)
@@ -331,12 +333,12 @@ class WholeBodyQP:
         self.fallbacks += 1
         return solution
 
-    def _daqp(self, problem: QpProblem, start: float, status: str = DAQP_ONLY) -> QpSolution:
-        """DAQP on the dense problem, as the solver or as OSQP's second.
+    def _daqp(self, problem: QpProblem, start: float, status: str | None = None) -> QpSolution:
+        """DAQP on the dense problem, as the solver or as OSQP's second (after OSQP's
+        ``status``).
 
         Raises:
-            WbcFailed: DAQP finds no finite solution (with OSQP's ``status`` if it was the
-                second).
+            WbcFailed: DAQP finds no finite solution (with OSQP's ``status``, if any).
         """
         x, flag, iterations, duals = solve_daqp(problem)
         if flag < 1 or not np.all(np.isfinite(x)):
