@@ -71,6 +71,52 @@ def test_a_wbc_that_keeps_failing_ends_in_a_safe_hold_that_the_summary_explains(
     assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # holds its joints
 
 
+def test_a_state_estimate_gone_non_finite_ends_in_a_safe_hold(dog) -> None:
+    """A NaN in the estimate (a sensor fault, a diverged filter) never reaches the MPC or
+    the WBC: the rider holds its joints from that tick, and the summary says when and why."""
+    rider = MpcRider(dog, "skateboard")
+    update = rider.estimator.update
+
+    def faulty(sensors):
+        state = update(sensors)
+        if sensors.time >= 0.5:
+            q = state.q.copy()
+            q[2] = np.nan
+            state = rider.estimator.state = replace(state, q=q)
+        return state
+
+    rider.estimator.update = faulty
+    result, rider = _ride(dog, 1.0, rider)
+    assert result.status == "ok" and not result.fell  # held, not crashed
+    hold = rider.summary()["safe_hold"]
+    assert hold is not None and "state estimate not finite" in hold["reason"]
+    assert 0.5 <= hold["time_s"] < 0.503
+    joints = result.log["qpos"][:, 7:]
+    assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # holds its joints
+
+
+def test_a_corrupt_library_entry_met_mid_ride_ends_in_a_safe_hold(dog, tmp_path, monkeypatch):
+    """push-off-0.5 picks up accelerate-0.50 when the command comes (0.5 s); with that file
+    corrupt, the rider holds, and the summary names the file."""
+    import shutil
+
+    import ridempc.mpc.reference as reference
+    from ridempc.paths import motion_library_dir
+
+    folder = tmp_path / "cyberdog2-skateboard"
+    shutil.copytree(motion_library_dir() / "cyberdog2-skateboard", folder)
+    (folder / "accelerate-0.50.npz").write_bytes(b"not an npz")
+    monkeypatch.setattr(reference, "library_folder", lambda robot, board: folder)
+    rider = MpcRider(dog, "skateboard")
+    scenario = resolve_scenario("push-off-0.5", "skateboard").with_duration(1.0)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    result = Simulation(scene, rider, scenario).run()
+    assert result.status == "ok" and not result.fell  # held, not crashed
+    hold = rider.summary()["safe_hold"]
+    assert hold is not None and "accelerate-0.50.npz" in hold["reason"]
+    assert 0.5 <= hold["time_s"] < 0.55
+
+
 def test_a_pair_without_an_mpc_is_refused(tmp_path, capsys) -> None:
     args = ["sim", "--robot", "cyberdog2", "--board", "none", "--controller", "mpc"]
     assert main([*args, "--out", str(tmp_path / "x")]) == 2
