@@ -3,8 +3,10 @@
 Every constraint keeps the same rows (and the same non-zero pattern) at every tick, so the
 QP's matrices keep a fixed sparsity pattern: an equality has :math:`l = u`, and a row that
 does not apply this tick (the contact rows of a foot in the air) gets
-:math:`l = -\\infty, u = +\\infty`. :meth:`Constraint.compute_qp_constraint` returns the
-block as a :class:`LinearConstraint` :math:`(C, l, u)`; an inequality
+:math:`l = -\\infty, u = +\\infty`. :meth:`Constraint.fill_qp_constraint` writes the block
+:math:`(C, l, u)` into its rows of the QP's own matrix and bounds, in place (the tick then
+allocates and stacks no blocks); :meth:`Constraint.compute_qp_constraint` returns it alone,
+as a :class:`LinearConstraint`. An inequality
 :math:`G z \\le h` is :math:`(G, -\\infty, h)` and an equality :math:`A z = b` is
 :math:`(A, b, b)`.
 """
@@ -70,10 +72,21 @@ class Constraint(ABC):
         self.layout = layout
 
     @abstractmethod
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        """Write the block's :math:`(C, l, u)` into ``block``: its ``matrix`` (rows, n_z)
+        holds zeros, its ``lower`` and ``upper`` (rows,) anything; every bound is set."""
+
     def compute_qp_constraint(
         self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> LinearConstraint:
-        """The block's :math:`(C, l, u)`."""
+        """The block's :math:`(C, l, u)` alone."""
+        block = LinearConstraint(
+            np.zeros((self.rows, self.layout.size)), np.empty(self.rows), np.empty(self.rows)
+        )
+        self.fill_qp_constraint(block, terms, targets, contacts)
+        return block
 
 
 class DynamicsConstraint(Constraint):
@@ -99,25 +112,26 @@ class DynamicsConstraint(Constraint):
     ) -> None:
         super().__init__(layout)
         self.rows = layout.nv
-        self._template = np.zeros((layout.nv, layout.size))
-        self._template[motor_v, layout.torque.start + np.arange(layout.n_motors)] = -1.0  # -S^T
+        self._motor_entries = (motor_v, layout.torque.start + np.arange(layout.n_motors))
         self._free = np.zeros(layout.nv, dtype=bool)
         if free_rows is not None:
             self._free[free_rows] = True
         self._any_free = bool(self._free.any())
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
-        layout = self.layout
-        matrix = self._template.copy()
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        layout, matrix = self.layout, block.matrix
+        matrix[self._motor_entries] = -1.0  # -S^T
         matrix[:, layout.acceleration] = terms.mass_matrix
         matrix[:, layout.force] = -terms.sites.jacobian.reshape(-1, layout.nv).T
         matrix[:, layout.loop_force] = -terms.loop_jacobian.T
         b = terms.passive - terms.bias
         if not self._any_free:
-            return LinearConstraint(matrix, b, b.copy())
-        return LinearConstraint(matrix, np.where(self._free, -INF, b), np.where(self._free, INF, b))
+            block.lower[:] = block.upper[:] = b
+            return
+        block.lower[:] = np.where(self._free, -INF, b)
+        block.upper[:] = np.where(self._free, INF, b)
 
 
 class RigidSpringConstraint(Constraint):
@@ -147,15 +161,14 @@ class RigidSpringConstraint(Constraint):
         super().__init__(layout)
         self.rows = len(spring_v)
         self._spring_v = np.asarray(spring_v, dtype=np.int64)
-        self._matrix = np.zeros((self.rows, layout.size))
-        self._matrix[np.arange(self.rows), self._spring_v] = 1.0
+        self._entries = (np.arange(self.rows), self._spring_v)
         self.damping = damping
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
-        b = -self.damping * terms.v[self._spring_v]
-        return LinearConstraint(self._matrix.copy(), b, b)
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        block.matrix[self._entries] = 1.0
+        block.lower[:] = block.upper[:] = -self.damping * terms.v[self._spring_v]
 
 
 class ClosedChainConstraint(Constraint):
@@ -171,13 +184,11 @@ class ClosedChainConstraint(Constraint):
         super().__init__(layout)
         self.rows = 3 * layout.n_loops
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
-        matrix = np.zeros((self.rows, self.layout.size))
-        matrix[:, self.layout.acceleration] = terms.loop_jacobian
-        b = -terms.loop_drift
-        return LinearConstraint(matrix, b, b)
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        block.matrix[:, self.layout.acceleration] = terms.loop_jacobian
+        block.lower[:] = block.upper[:] = -terms.loop_drift
 
 
 class ContactAccelerationConstraint(Constraint):
@@ -211,14 +222,14 @@ class ContactAccelerationConstraint(Constraint):
         self.rows = self._split + 2 * self._second.size
         self._row_site = np.concatenate([np.repeat(self._first, 3), np.repeat(self._second, 2)])
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
         nv, split = self.layout.nv, self._split
         sites = terms.sites
         first, second = self._first, self._second
         wanted = contacts.acceleration - sites.drift
-        matrix = np.zeros((self.rows, self.layout.size))
+        matrix = block.matrix
         matrix[:split, :nv] = sites.jacobian[first].reshape(-1, nv)
         b = np.empty(self.rows)
         b[:split] = wanted[first].ravel()
@@ -234,7 +245,8 @@ class ContactAccelerationConstraint(Constraint):
                     -1, coupling.shape[-1]
                 )
         active = contacts.active[self._row_site]
-        return LinearConstraint(matrix, np.where(active, b, -INF), np.where(active, b, INF))
+        block.lower[:] = np.where(active, b, -INF)
+        block.upper[:] = np.where(active, b, INF)
 
 
 class FrictionPyramidConstraint(Constraint):
@@ -294,16 +306,14 @@ class FrictionPyramidConstraint(Constraint):
         # box; t1 + t2 - mu n, t1 - t2 - mu n, t2 - t1 - mu n, -t1 - t2 - mu n, n in the diamond
         self._pyramid = np.vstack([0.0 - pyramid[1:], pyramid[:1]])  # (no negative zeros)
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
         rows = self._pyramid @ contacts.frame  # (sites, 5, 3)
-        matrix = np.zeros((self.rows, self.layout.size))
-        matrix[self._row_index, self._column_index] = rows.ravel()
+        block.matrix[self._row_index, self._column_index] = rows.ravel()
         active = np.repeat(contacts.active, 5)
-        lower = np.where(active, self._contact_lower, self._swing_lower)
-        upper = np.where(active, self._contact_upper, self._swing_upper)
-        return LinearConstraint(matrix, lower, upper)
+        block.lower[:] = np.where(active, self._contact_lower, self._swing_lower)
+        block.upper[:] = np.where(active, self._contact_upper, self._swing_upper)
 
 
 class PlatformTipConstraint(Constraint):
@@ -348,10 +358,10 @@ class PlatformTipConstraint(Constraint):
             cached = self._entries[key] = (plus, plus + 1, columns)
         return cached
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
-        matrix = np.zeros((self.rows, self.layout.size))
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        matrix = block.matrix
         tipping = contacts.tipping[: self.rows // 2]
         if tipping:
             counts = [len(t[0]) for t in tipping]
@@ -363,7 +373,8 @@ class PlatformTipConstraint(Constraint):
             side, normal = axes[:, 1], axes[:, 2]
             matrix[plus, columns] = ((offsets - ratio) * normal - side).ravel()
             matrix[minus, columns] = ((-offsets - ratio) * normal + side).ravel()
-        return LinearConstraint(matrix, self._lower.copy(), self._upper.copy())
+        block.lower[:] = self._lower
+        block.upper[:] = self._upper
 
 
 class TorqueLimitConstraint(Constraint):
@@ -377,11 +388,12 @@ class TorqueLimitConstraint(Constraint):
     def __init__(self, layout: DecisionLayout, limits: Array) -> None:
         super().__init__(layout)
         self.rows = layout.n_motors
-        self._matrix = np.zeros((self.rows, layout.size))
-        self._matrix[:, layout.torque] = np.eye(layout.n_motors)
+        self._entries = (np.arange(self.rows), layout.torque.start + np.arange(self.rows))
         self._limits = np.asarray(limits, dtype=float)
 
-    def compute_qp_constraint(
-        self, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
-    ) -> LinearConstraint:
-        return LinearConstraint(self._matrix.copy(), -self._limits, self._limits.copy())
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        block.matrix[self._entries] = 1.0
+        block.lower[:] = -self._limits
+        block.upper[:] = self._limits

@@ -47,13 +47,13 @@ import scipy.sparse as sparse
 from numpy.typing import NDArray
 
 from ridempc.errors import RidempcError
-from ridempc.wbc.constraints import Constraint
+from ridempc.wbc.constraints import Constraint, LinearConstraint
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
 from ridempc.wbc.settings import DEFAULT_OSQP_SETTINGS
 from ridempc.wbc.targets import WbcTargets
-from ridempc.wbc.tasks import Task
+from ridempc.wbc.tasks import Objective, Task
 from ridempc.wbc.workspace import OsqpResult, OsqpWorkspace
 
 __all__ = ["QpProblem", "QpSolution", "WbcFailed", "WholeBodyQP", "solve_daqp"]
@@ -230,6 +230,8 @@ class WholeBodyQP:
         self.constraints = tuple(c for c in constraints if c.rows > 0)
         self.settings = {**DEFAULT_OSQP_SETTINGS, **(settings or {})}
         self.rows = sum(c.rows for c in self.constraints)
+        ends = np.cumsum([0] + [c.rows for c in self.constraints])
+        self._row_slices = tuple(slice(a, b) for a, b in zip(ends[:-1], ends[1:], strict=True))
         n = layout.size
         self._p_mask = np.eye(n, dtype=bool)
         self._a_mask = np.zeros((self.rows, n), dtype=bool)
@@ -249,14 +251,14 @@ class WholeBodyQP:
         n = self.layout.size
         hessian = np.zeros((n, n))
         gradient = np.zeros(n)
+        objective = Objective(hessian, gradient)
         for task in self.tasks:
-            h, c = task.compute_qp_objective(terms, targets, contacts)
-            hessian += h
-            gradient += c
-        blocks = [c.compute_qp_constraint(terms, targets, contacts) for c in self.constraints]
-        matrix = np.vstack([b.matrix for b in blocks]) if blocks else np.zeros((0, n))
-        lower = np.concatenate([b.lower for b in blocks]) if blocks else np.zeros(0)
-        upper = np.concatenate([b.upper for b in blocks]) if blocks else np.zeros(0)
+            task.add_qp_objective(objective, terms, targets, contacts)
+        matrix = np.zeros((self.rows, n))
+        lower, upper = np.empty(self.rows), np.empty(self.rows)
+        for constraint, rows in zip(self.constraints, self._row_slices, strict=True):
+            block = LinearConstraint(matrix[rows], lower[rows], upper[rows])  # views
+            constraint.fill_qp_constraint(block, terms, targets, contacts)
         return QpProblem(
             hessian, gradient, matrix, lower, upper, build_time=time.perf_counter() - start
         )
