@@ -315,6 +315,47 @@ def test_a_stance_with_a_foot_landed_inward_rides_a_cut_roll_wave(dog) -> None:
     assert rider.stance is not None and rider.stance.last[1] < 0.1  # the wave was cut
 
 
+def test_the_hovershoes_rider_reads_a_planned_speed_over_its_horizon() -> None:
+    """velocity-steps plans 0.5 m/s from 3.0 s: where the commands are planned, the
+    Hovershoes' manoeuvre follows the speed planned for the end of the MPC's horizon
+    (0.4 s), so from 2.6 s; without a plan, or on the Segway, the command of the moment."""
+    cassie = load_robot("cassie")
+    shoes, segway = MpcRider(cassie, "hovershoes"), MpcRider(cassie, "segway")
+    scenario = resolve_scenario("velocity-steps", "hovershoes")
+    horizon = shoes.mpc.settings.horizon * shoes.mpc.settings.dt
+    assert horizon == pytest.approx(0.4)
+    now = scenario.command_at(2.7)
+    assert now.velocity == 0.0
+    assert shoes._speed_command(now, 2.7).velocity == 0.0  # no plan given yet
+    for rider in (shoes, segway):
+        rider.command_preview = scenario.command_at
+    assert shoes._speed_command(now, 2.7).velocity == 0.5
+    ahead = shoes._speed_command(now, 2.7)
+    assert ahead.yaw_rate == now.yaw_rate  # only the speed is read ahead
+    assert shoes._speed_command(scenario.command_at(2.55), 2.55).velocity == 0.0
+    assert segway._speed_command(now, 2.7).velocity == 0.0  # the Segway does not preview
+    assert shoes.summary()["speed_preview_s"] == pytest.approx(0.4)  # the summary says so
+    assert segway.summary()["speed_preview_s"] == 0.0
+
+
+def test_cassie_leans_into_a_planned_speed_step_on_the_hovershoes() -> None:
+    """velocity-steps' first step (0 -> 0.5 m/s at 3.0 s), ridden to 4.5 s: read 0.4 s
+    ahead, the step is under way when it comes (0.12 m/s at 3.0 s, seed 0; at once, the
+    rider was still at rest) and held within 0.03 m/s from 4.0 s (the whole ride's
+    velocity RMSE, 0.105 m/s at once, is 0.053 so)."""
+    cassie = load_robot("cassie")
+    rider = MpcRider(cassie, "hovershoes")
+    scenario = resolve_scenario("velocity-steps", "hovershoes").with_duration(4.5)
+    scene = build_scene(cassie, DEFAULT_PHYSICS_HZ, board=load_board("hovershoes"))
+    result = Simulation(scene, rider, scenario).run()
+    assert result.status == "ok" and not result.fell
+    t, speed = result.log["time"], result.log["forward_velocity"]
+    settled = (t > 1.0) & (t < 2.5)  # after the first second's settling on the shoes
+    assert np.all(np.abs(speed[settled]) < 0.04)  # at rest before the lean-in
+    assert speed[np.searchsorted(t, 3.0)] > 0.06  # under way when the step comes
+    assert np.all(np.abs(speed[t >= 4.0] - 0.5) < 0.03)
+
+
 def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     """Cassie's motor PD follows the WBC at a tenth of its gains (``tracking_gain_scale``);
     with the MPC she then stands on the Hovershoes (at full gains the stiff PD overrode the

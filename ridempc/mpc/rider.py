@@ -402,7 +402,9 @@ class MpcRider(Controller):
         # the rider's at 3-4 m/s, and one swing started the 4 m/s push 0.36 m/s ahead of
         # the rider (velocity-steps fell at 19.9 s).
         rider_speed = self.map.rider_speed(estimate)
-        wanted = self.selector.select(command, self.manoeuvre, now, rider_speed)
+        wanted = self.selector.select(
+            self._speed_command(command, now), self.manoeuvre, now, rider_speed
+        )
         if wanted is not self.manoeuvre:
             self.mpc.retarget(wanted.library_kind, wanted.target)
             reference = self.mpc.reference
@@ -657,6 +659,25 @@ class MpcRider(Controller):
             return planned
         return np.full(settings.horizon, float(command.yaw_rate))
 
+    def _speed_preview_s(self) -> float:
+        """How far ahead the manoeuvre reads a planned speed [s]: the MPC's horizon where the
+        pair previews it and the ride's commands are planned, else 0
+        (:attr:`~ridempc.mpc.pairs.MpcPair.speed_preview`)."""
+        if not self.pair.speed_preview or self.command_preview is None:
+            return 0.0
+        return self.mpc.settings.horizon * self.mpc.settings.dt
+
+    def _speed_command(self, command: Command, now: float) -> Command:
+        """``command`` with the speed planned ``_speed_preview_s`` ahead."""
+        lead = self._speed_preview_s()
+        if lead == 0.0:
+            return command
+        assert self.command_preview is not None
+        ahead = self.command_preview(now + lead).velocity
+        if ahead == command.velocity:
+            return command
+        return command.model_copy(update={"velocity": ahead})
+
     def _planned(self, field: str, times: NDArray[np.floating[Any]]) -> Array | None:
         """One field of the ride's planned commands at ``times`` [s] (``command_preview``),
         or None when the commands are not planned ahead."""
@@ -754,6 +775,7 @@ class MpcRider(Controller):
                 out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
         qp = self.mpc.qp
         out["mpc_solves"] = len(self._mpc_ms)
+        out["speed_preview_s"] = self._speed_preview_s()
         out["mpc_fallbacks"] = int(qp.failures) if qp is not None else 0
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries
