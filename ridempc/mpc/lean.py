@@ -43,6 +43,11 @@ gives, so the rider holds that input at zero and leans instead, as the ``pd`` ba
      the rider's yaw while the board turned under her, and her pelvis followed the board
      0.2-0.3 s late (in a prototype that laid on the measured yaw rate instead, the
      rider's yaw fed itself and she fell at 7.75 s);
+   - the heading the library frame follows (the board's direction of travel, low-passed
+     over 0.3 s) is carried by the same commanded rate
+     (:meth:`~ridempc.mpc.state_map.StateMap.follow_sideways`): low-passed alone, it
+     lagged a steady turn by 0.15 rad at 0.5 rad/s, and the MPC held the pelvis and the
+     centre of mass's velocity outside the turn;
    - the frame that follows the board turns with it at :math:`\\hat\\omega`, which the
      MPC's model does not know: in it the centre of mass feels the centrifugal
      acceleration :math:`-v \\hat\\omega` across the heading (:math:`v` the board's
@@ -55,10 +60,14 @@ gives, so the rider holds that input at zero and leans instead, as the ``pd`` ba
    of mass approach a fixed offset over about a second, and it settled at an eighth of it.
    Yaw-steps (1 m/s, 0.5 rad/s for 10 s) overshot the step to 1.1 rad/s and rang for 3 s
    after each step: yaw-rate RMSE 0.170/0.184/0.175 rad/s on seeds 0/1/2 (the ``pd``
-   baseline's 0.117/0.118/0.117); as built, 0.082/0.086/0.084. Seed 0, one change at a
-   time from it: without the path (the lean at every node), 0.119; without the turned yaw
-   references, 0.153; without the gyro in the followed heading, 0.106; without the
-   centrifugal drift, 0.085 (the circle at 2 m/s and 0.5 rad/s: 0.035 -> 0.043).
+   baseline's 0.117/0.118/0.117); as built, 0.061/0.060/0.061. Seed 0, one change at a
+   time from it: without the path (the lean at every node), 0.072; without the turned yaw
+   references, 0.092; without the turn carrying the followed heading, 0.106; without the
+   centrifugal drift, 0.064 (the circle at 2 m/s and 0.5 rad/s: 0.028 -> 0.034). The
+   board itself (its yaw rate averaged over 0.1 s) tracks with 0.109 rad/s (the ``pd``
+   rider's 0.120, before 0.196): its steering still waits the 0.3 s the lean takes to
+   push the bar, and the rider's pelvis, turned with the command, leads it, up to 0.13
+   rad off the board at a step (the ``pd`` rider's 0.05).
 
    *Standing* (slower), the loop holds the yaw rate at zero, whatever the command, and the
    reference sits at ``STANDING_PULL`` :math:`\\times s` over the whole horizon, as before:
@@ -114,7 +123,7 @@ LEAN_GAINS = LoopGains(
     integral_limit=0.08,  # [m]
     max_shift=0.1,  # [m]
     # [m/s] twice the pd rider's: riding, the path takes the centre of mass there (yaw-steps
-    # seed 0, yaw-rate RMSE 0.104 at 0.1, 0.082 at 0.2)
+    # seed 0 with the heading carried by the gyro, yaw-rate RMSE 0.104 at 0.1, 0.082 at 0.2)
     max_rate=0.2,
     filter_hz=5.0,  # [Hz] on the yaw rate
 )

@@ -18,9 +18,8 @@ Every 2 ms (500 Hz) the rider
    the rate the roll steers (eq. 14); on the Segway, whose knee bar the plan cannot push,
    the rider crouches into the robot's riding keyframe and leans into the bar: a yaw-rate
    loop moves the reference's centre of mass sideways, and riding, the reference's
-   headings turn at the commanded rate and the frame's turn (the heading it follows,
-   carried by the gyro) pulls the centre of mass outwards in the plan
-   (:mod:`ridempc.mpc.lean`);
+   headings and the heading the frame follows turn at the commanded rate and the frame's
+   turn pulls the centre of mass outwards in the plan (:mod:`ridempc.mpc.lean`);
    on the Hovershoes the MPC also sees where each foot stands along its shoe and each
    shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
    :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, each shoe's heading is
@@ -433,12 +432,14 @@ class MpcRider(Controller):
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
         yaw_rate = _base_yaw_rate(estimate)
-        self._follow_board(mapped, here, turn, now, coasting, yaw_rate)
+        if self.lean is not None:
+            self.lean.update(now, command.yaw_rate, yaw_rate, speed)
+        carried = self.lean.turn_rate if self.lean is not None else 0.0
+        self._follow_board(mapped, here, turn, now, coasting, carried)
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
         drift = self._roll_drift(x0, now, balancing, estimate)
         if self.lean is not None:
-            self.lean.update(now, command.yaw_rate, yaw_rate, speed)
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
@@ -613,7 +614,7 @@ class MpcRider(Controller):
         so far), along it by what lies beyond :data:`~ridempc.mpc.state_map.ALONG_SLACK`,
         and all along it while turning or coasting (the reference's steady ride is not
         where a coasting board goes); on a board whose heading the frame follows, that
-        heading carried by the estimated ``yaw_rate`` [rad/s]."""
+        heading carried by ``yaw_rate`` [rad/s], the turn the rider is making."""
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])

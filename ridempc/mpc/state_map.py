@@ -314,20 +314,23 @@ class StateMap:
         off. Below ``HEADING_SPEED`` the frame does not turn.
 
         The followed heading is a complementary filter: over a tick of :math:`\\Delta t`
-        the frame's yaw :math:`\\psi_f` is first carried by the measured ``yaw_rate``
-        :math:`\\omega` [rad/s] (the base's gyro about world z), then drawn towards the
-        direction of travel :math:`\\psi_{tr}`,
+        the frame's yaw :math:`\\psi_f` is first carried by the turn rate ``yaw_rate``
+        :math:`\\omega` [rad/s] (the rider's: the turn she commands), then drawn towards
+        the direction of travel :math:`\\psi_{tr}`,
 
         .. math:: \\psi^- = \\psi_f + \\omega \\Delta t, \\qquad
             \\psi_f \\leftarrow \\psi^- + \\min(1, \\Delta t / T)\\,
             \\operatorname{wrap}(\\psi_{tr} - \\psi^-)
 
-        with :math:`T` = ``HEADING_FILTER_S``: the travel sets the heading, the gyro its
+        with :math:`T` = ``HEADING_FILTER_S``: the travel sets the heading, the turn its
         changes. The low-pass alone lags a steady turn by :math:`\\omega T`, 0.15 rad at
         0.5 rad/s, and the MPC, holding the rider's pelvis and velocity on the lagging
         heading, leaned her out of the turn she was leaning into (Segway yaw-steps, seed
         0, the lean loop of before, :mod:`~ridempc.mpc.lean`: it held 0.5 rad/s with 0.35 m
-        of reference offset; carried by the gyro, with 0.12 m).
+        of reference offset; carried by the base gyro's yaw rate, with 0.12 m). The gyro
+        carries the rider's own yaw into the frame her yaw is held in: riding straight
+        (velocity-steps) her pelvis wandered up to 0.14 rad off the board, 0.016 rad
+        carried by the commanded turn.
 
         Args:
             estimate: The state estimate.
