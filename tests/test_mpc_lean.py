@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -10,6 +12,7 @@ from ridempc.mpc.lean import (
     CROUCH_DELAY,
     CROUCH_SECONDS,
     LEAN_GAINS,
+    STANDING_PULL,
     Crouch,
     LeanSteering,
     com_height,
@@ -69,34 +72,99 @@ def test_the_crouch_comes_in_over_its_ramp(segway_rider, problem) -> None:
         Crouch(float("nan"))
 
 
-def test_the_lean_grows_towards_the_turn_and_moves_the_balance_along(segway_rider, problem) -> None:
-    """A left turn commanded and none measured: the offset is positive (to the left),
-    grows while the error lasts, stays within pull x max_shift, and moves the reference's
-    balance (forces) with it; with no offset the problem is untouched."""
+def test_standing_the_lean_grows_against_the_turn_and_moves_the_balance_along(
+    segway_rider, problem
+) -> None:
+    """Standing, a left turn commanded and a fast right one measured: the loop holds the yaw
+    rate at zero, so the offset is positive (to the left), grows while the error lasts,
+    stays within the standing pull x max_shift, and moves the reference's balance
+    (forces) with it at every node; with no offset the problem is untouched."""
     steering = LeanSteering()
-    side = segway_rider.layout.names["com_y"]
-    assert steering.lean(problem, side, None) is problem
-    offsets = [steering.update(0.1 * k, 0.5, 0.0, 1.0) for k in range(200)]
+    names = segway_rider.layout.names
+    side, rate = names["com_y"], names["vy"]
+    assert steering.lean(problem, side, rate, None) is problem
+    slow = 0.5 * steering.min_speed
+    offsets = [steering.update(0.1 * k, 0.5, -1.0, slow) for k in range(200)]
+    assert not steering.riding and steering.turn_rate == 0.0
     assert offsets[1] > 0.0 and offsets[50] > offsets[5]
-    bound = steering.pull * LEAN_GAINS.max_shift
+    bound = STANDING_PULL * LEAN_GAINS.max_shift
     assert max(offsets) <= bound + 1e-12 and offsets[-1] == pytest.approx(bound)
     nx, nu = problem.state_reference.shape[1], problem.input_reference.shape[1]
-    other = segway_rider.layout.names["pelvis_roll"]
+    other = names["pelvis_roll"]
     balance = StaticShift(
         states=np.eye(nx)[side] + 0.5 * np.eye(nx)[other],
         inputs=np.full(nu, 100.0),
         velocities=np.zeros(nx),
     )
     states, inputs = problem.state_reference, problem.input_reference
-    moved = steering.lean(problem, side, balance)
+    moved = steering.lean(problem, side, rate, balance)
     np.testing.assert_allclose(moved.state_reference[:, side], states[:, side] + bound)
     np.testing.assert_allclose(moved.state_reference[:, other], states[:, other] + 0.5 * bound)
+    np.testing.assert_allclose(moved.state_reference[:, rate], states[:, rate])
     np.testing.assert_allclose(moved.input_reference, inputs + 100.0 * bound)
-    slow = LeanSteering()  # too slow to turn: holds the yaw rate at zero
-    assert slow.update(0.1, 0.5, 0.0, 0.5 * slow.min_speed) == 0.0
-    assert slow.update(0.2, 0.5, -0.2, 0.5 * slow.min_speed) > 0.0  # turning right: leans left
+    assert steering.turn(problem, names) is problem  # standing: no turn laid on
+    assert steering.drift(nx, rate, 0.2, 0.3) is None
+    still = LeanSteering()  # standing still, nothing turning: nothing leans
+    assert still.update(0.1, 0.5, 0.0, slow) == 0.0
     with pytest.raises(ValueError, match="pull"):
-        LeanSteering(pull=0.0)
+        LeanSteering(standing_pull=0.0)
+    with pytest.raises(ValueError, match="time constant"):
+        LeanSteering(seconds=0.0)
+
+
+def test_riding_the_lean_is_a_path_from_the_centre_of_mass(segway_rider, problem) -> None:
+    """Riding, the offset is the loop's shift itself (the feedforward's 0.08 m per rad/s
+    at the first tick, slewed), and the reference's CoM y runs from the initial state's
+    offset to it as :math:`s + (y_0 - s) e^{-k \\Delta t / T}`, its :math:`\\dot y` the
+    path's rate, which the path integrates (trapezoids, to within a millimetre)."""
+    steering = LeanSteering()
+    names = segway_rider.layout.names
+    side, rate = names["com_y"], names["vy"]
+    first = steering.update(0.0, 0.5, 0.0, 1.0)
+    assert steering.riding and steering.turn_rate == 0.5
+    assert first == 0.0  # the slew starts from zero
+    offset = steering.update(0.2, 0.5, 0.0, 1.0)
+    assert offset == pytest.approx(LEAN_GAINS.max_rate * 0.2)  # slewed towards 0.04+ m
+    x0 = problem.initial_state.copy()
+    x0[side] = problem.state_reference[0, side] - 0.03  # the CoM 3 cm right of the line
+    moved = steering.lean(replace(problem, initial_state=x0), side, rate, None)
+    path = moved.state_reference[:, side] - problem.state_reference[:, side]
+    k = np.arange(len(path))
+    expected = offset + (-0.03 - offset) * np.exp(-k * problem.dt / steering.seconds)
+    np.testing.assert_allclose(path, expected)
+    assert path[0] == pytest.approx(-0.03) and abs(path[-1] - offset) < abs(path[1] - offset)
+    speed = moved.state_reference[:, rate] - problem.state_reference[:, rate]
+    assert speed[0] == pytest.approx((offset + 0.03) / steering.seconds)
+    steps = 0.5 * (speed[1:] + speed[:-1]) * problem.dt
+    np.testing.assert_allclose(np.diff(path), steps, atol=1e-3)
+
+
+def test_riding_the_turn_is_laid_on_the_yaw_references_and_its_pull_on_the_rates(
+    segway_rider, problem
+) -> None:
+    """Riding at 0.5 rad/s: every heading of the reference turns by 0.5 k dt and every
+    yaw rate gains 0.5 rad/s, nothing else moves; the drift is the centrifugal
+    acceleration :math:`-v \\hat\\omega` on the CoM's :math:`\\dot y` alone."""
+    steering = LeanSteering()
+    names = segway_rider.layout.names
+    steering.update(0.0, 0.5, 0.0, 1.0)
+    turned = steering.turn(problem, names)
+    before, after = problem.state_reference, turned.state_reference
+    k = np.arange(before.shape[0])
+    headings = [names["pelvis_yaw"], names["segway_psi"]]
+    rates = [names["wz"], names["segway_yaw_rate"]]
+    for heading in headings:
+        np.testing.assert_allclose(after[:, heading] - before[:, heading], 0.5 * k * problem.dt)
+    np.testing.assert_allclose(after[:, rates] - before[:, rates], 0.5)
+    others = [i for i in range(before.shape[1]) if i not in headings + rates]
+    np.testing.assert_array_equal(after[:, others], before[:, others])
+    nx = before.shape[1]
+    drift = steering.drift(nx, names["vy"], 2.0, 0.4)
+    assert drift is not None
+    np.testing.assert_allclose(drift, -0.8 * np.eye(nx)[names["vy"]])
+    straight = LeanSteering()
+    straight.update(0.0, 0.0, 0.0, 1.0)
+    assert straight.turn(problem, names) is problem
 
 
 def test_on_the_segway_cassie_crouches_and_turns_by_the_knee_bar(cassie, tmp_path) -> None:

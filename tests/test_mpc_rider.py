@@ -11,9 +11,9 @@ import pytest
 
 from ridempc.boards import load_board
 from ridempc.cli import main
-from ridempc.estimation import EstimatedState
+from ridempc.estimation import BoardEstimate, EstimatedState
 from ridempc.mpc.rider import WBC_GRACE_TICKS, MpcRider
-from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S
+from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S, StateMap
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -485,18 +485,23 @@ def test_turns_are_laid_over_the_boards_the_rider_can_turn() -> None:
     assert not segway.steers and segway._follows_heading
 
 
+def _board_on_its_line(dog) -> tuple[EstimatedState, StateMap, BoardEstimate, tuple[float, ...]]:
+    """After 0.1 s on the skateboard: the estimate, the rider's state map, the board's
+    estimate and a reference pose (x, y, heading 0) through the board's place."""
+    _, rider = _ride(dog, 0.1)
+    estimate = rider.estimator.state
+    assert estimate is not None and estimate.boards
+    board = estimate.boards[0]
+    place = rider.map.frame.point_to_library(board.position)
+    return estimate, rider.map, board, (float(place[0]), float(place[1]), 0.0)
+
+
 def test_the_frame_turns_with_the_direction_of_travel(dog) -> None:
     """With ``heading``, the frame turns about the board until the board's direction of
     travel (0.1 rad off, whatever its estimated yaw) is the reference's heading, low-passed
     over ``HEADING_FILTER_S``, and the board stays on the reference's line; slower than
     ``HEADING_SPEED`` it does not turn."""
-    _, rider = _ride(dog, 0.1)
-    estimate = rider.estimator.state
-    assert estimate is not None and estimate.boards
-    state_map = rider.map
-    board = estimate.boards[0]
-    place = state_map.frame.point_to_library(board.position)
-    pose = (float(place[0]), float(place[1]), 0.0)
+    estimate, state_map, board, pose = _board_on_its_line(dog)
     start = state_map.frame.yaw
 
     def moving(speed: float, time: float) -> EstimatedState:
@@ -513,5 +518,32 @@ def test_the_frame_turns_with_the_direction_of_travel(dog) -> None:
     for k in range(1, 61):
         state_map.follow_sideways(moving(3.0, t0 + 2.0 + k / 30.0), pose, heading=True)
     assert state_map.frame.yaw - start == pytest.approx(0.1, abs=1e-6)
+    on_line = state_map.frame.point_to_library(board.position)
+    assert on_line[1] == pytest.approx(pose[1], abs=1e-9)
+
+
+def test_the_followed_heading_is_carried_by_the_yaw_rate_through_a_steady_turn(dog) -> None:
+    """A board's direction of travel turning at 0.5 rad/s for 2 s: the low-passed heading
+    lags it by about :math:`\\omega T` (0.133 rad at 30 Hz), the heading carried by the
+    yaw rate not at all; its place on the reference's line is kept either way."""
+    estimate, state_map, board, pose = _board_on_its_line(dog)
+    start, frame, t0 = state_map.frame.yaw, state_map.frame, estimate.time
+    rate = 0.5  # [rad/s]
+
+    def lag(yaw_rate: float) -> float:
+        state_map.frame = frame
+        state_map.follow_sideways(replace(estimate, time=t0), pose)  # the filter's clock
+        travel = start
+        for k in range(1, 61):  # 2 s at 30 Hz
+            travel = start + rate * k / 30.0
+            velocity = 3.0 * np.array([np.cos(travel), np.sin(travel), 0.0])
+            boards = (replace(board, velocity=velocity),)
+            moved = replace(estimate, time=t0 + k / 30.0, boards=boards)
+            state_map.follow_sideways(moved, pose, heading=True, yaw_rate=yaw_rate)
+        return travel - state_map.frame.yaw
+
+    share = (1.0 / 30.0) / HEADING_FILTER_S
+    assert lag(0.0) == pytest.approx(rate / 30.0 * (1.0 - share) / share, rel=5e-3)
+    assert lag(rate) == pytest.approx(0.0, abs=1e-9)
     on_line = state_map.frame.point_to_library(board.position)
     assert on_line[1] == pytest.approx(pose[1], abs=1e-9)

@@ -21,32 +21,67 @@ gives, so the rider holds that input at zero and leans instead, as the ``pd`` ba
 2. **Lean loop** (:class:`LeanSteering`). The baseline's :class:`~ridempc.baselines.
    cassie_segway.ShiftLoop` on the yaw rate :math:`\\hat\\omega` [rad/s] (the estimate's
    base angular velocity about world z) gives a lean :math:`s` [m] (``LEAN_GAINS``, the
-   ``pd`` rider's ``[turning]`` gains: feedforward on the command, PI on the error, bounded
-   and slewed), and the MPC's centre-of-mass reference moves sideways by
-
-   .. math:: y^{CoM}_k \\mathrel{+}= g\\, s
-
-   [m] in the library frame (y to the left), with the static balance shift of the forces
+   ``pd`` rider's ``[turning]`` gains but slewed twice as fast: feedforward on the command,
+   PI on the error, bounded), and the MPC's centre-of-mass reference moves sideways in the
+   library frame (y to the left), with the static balance shift of the forces
    (:func:`~ridempc.mpc.statics.static_shift`: load moves onto the near foot).
-   :math:`g` = ``LEAN_PULL``: the pad pushes back on the shins with a force that neither the
-   MPC nor the whole-body QP models, and each MPC tick plans from where that force has
-   left the rider, so the centre of mass settles at a fraction of its reference's offset.
-   Measured on the Segway's circle (2 m/s at 0.5 rad/s, seed 0) with a prototype that
-   lowered the reference by the ``pd`` rider's pelvis drop, 0.277 m: at :math:`g = 1` the
-   lean saturated at 0.1 m while the pelvis moved 0.012 m off the platform's centre, the
-   bar tilted 0.01 rad and the Segway turned at 0.07 rad/s (yaw-rate RMSE 0.429 rad/s); at
-   2.5, 4, 6 and 8 the RMSE was 0.304, 0.195, 0.087 and 0.057 rad/s (the ``pd`` baseline's
-   0.043), the bar at about 0.06 rad. As built (the keyframes' 0.255 m, :math:`g = 8`):
-   0.063 rad/s.
 
-   The rider follows a commanded turn only while the board rolls at ``HEADING_SPEED`` or
-   more, where the library frame turns with the board's direction of travel
-   (:meth:`~ridempc.mpc.state_map.StateMap.follow_sideways`); slower, the loop holds the
-   yaw rate at zero. Standing still the frame keeps its heading, the plan holds the rider's
-   yaw against the turning platform, the loop winds up, and the bar was pushed to 0.26
-   rad: the Segway spun at 1.5 rad/s and Cassie fell 2 s after a 0.5 rad/s command
-   (turning in place is left undone). Without the loop at all below that speed, the
-   offset-start's crouched rider pushed the bar unchecked and fell.
+   *Riding* (the board at ``HEADING_SPEED`` or more, where the library frame turns with
+   the board's direction of travel, :meth:`~ridempc.mpc.state_map.StateMap.
+   follow_sideways`), the reference is the lean itself, reached along a path from where
+   the centre of mass is, :math:`y_0` [m] (off the reference's line),
+
+   .. math:: y_k = s + (y_0 - s)\\, e^{-k \\Delta t / T}, \\qquad
+       \\dot y_k = -\\frac{y_0 - s}{T}\\, e^{-k \\Delta t / T}
+
+   over the horizon's nodes :math:`k`, :math:`T` = ``LEAN_SECONDS``; and the MPC is told of
+   the turn the lean makes (:meth:`LeanSteering.turn`, :meth:`LeanSteering.drift`):
+
+   - the rider's and the board's headings and yaw rates in the reference turn at the
+     commanded rate :math:`\\omega^*`, :math:`\\psi_k \\mathrel{+}= \\omega^* k \\Delta t`,
+     :math:`\\omega_{z,k} \\mathrel{+}= \\omega^*`: held at zero yaw rate, the plan braked
+     the rider's yaw while the board turned under her, and her pelvis followed the board
+     0.2-0.3 s late (in a prototype that laid on the measured yaw rate instead, the
+     rider's yaw fed itself and she fell at 7.75 s);
+   - the heading the library frame follows (the board's direction of travel, low-passed
+     over 0.3 s) is carried by the same commanded rate
+     (:meth:`~ridempc.mpc.state_map.StateMap.follow_sideways`): low-passed alone, it
+     lagged a steady turn by 0.15 rad at 0.5 rad/s, and the MPC held the pelvis and the
+     centre of mass's velocity outside the turn;
+   - the frame that follows the board turns with it at :math:`\\hat\\omega`, which the
+     MPC's model does not know: in it the centre of mass feels the centrifugal
+     acceleration :math:`-v \\hat\\omega` across the heading (:math:`v` the board's
+     speed [m/s]), added to the rates of :math:`\\dot y` as a drift (0.5 m/s² at 1 m/s and
+     0.5 rad/s, which the rider meets by leaning into the turn).
+
+   Before, the reference sat at :math:`g s` with :math:`g = 8`, the heading followed with a
+   lag of :math:`\\omega T` and neither the turn nor its centrifugal pull was in the plan:
+   the MPC's tolerances (0.05 m on :math:`y`, 0.05 m/s on :math:`\\dot y`) let the centre
+   of mass approach a fixed offset over about a second, and it settled at an eighth of it.
+   Yaw-steps (1 m/s, 0.5 rad/s for 10 s) overshot the step to 1.1 rad/s and rang for 3 s
+   after each step: yaw-rate RMSE 0.170/0.184/0.175 rad/s on seeds 0/1/2 (the ``pd``
+   baseline's 0.117/0.118/0.117); as built, 0.061/0.060/0.061. Seed 0, one change at a
+   time from it: without the path (the lean at every node), 0.072; without the turned yaw
+   references, 0.092; without the turn carrying the followed heading, 0.106; without the
+   centrifugal drift, 0.064 (the circle at 2 m/s and 0.5 rad/s: 0.028 -> 0.034). The
+   board itself (its yaw rate averaged over 0.1 s) tracks with 0.109 rad/s (the ``pd``
+   rider's 0.120, before 0.196): its steering still waits the 0.3 s the lean takes to
+   push the bar, and the rider's pelvis, turned with the command, leads it, up to 0.13
+   rad off the board at a step (the ``pd`` rider's 0.05).
+
+   *Standing* (slower), the loop holds the yaw rate at zero, whatever the command, and the
+   reference sits at ``STANDING_PULL`` :math:`\\times s` over the whole horizon, as before:
+   the pad pushes back on the shins with a force that neither the MPC nor the whole-body
+   QP models, and each MPC tick plans from where that force has left the rider, so the
+   centre of mass settles at a fraction of its reference's offset (8 was found on the
+   circle, where riding used it too: yaw-rate RMSE 0.429, 0.304, 0.195, 0.087 and 0.057
+   rad/s at 1, 2.5, 4, 6 and 8; the offset-start's rider, feet 1 cm to the left, pushes
+   the bar with a shin: with riding's path and unit pull she let it reach 0.04 rad and
+   fell at 5.8 s). Standing still the frame keeps its heading, the plan holds the rider's
+   yaw against the turning platform, the loop winds up, and following a 0.5 rad/s command
+   the bar was pushed to 0.26 rad: the Segway spun at 1.5 rad/s and Cassie fell 2 s later
+   (turning in place is left undone). Without the loop at all, the offset-start's
+   crouched rider pushed the bar unchecked and fell.
 """
 
 from __future__ import annotations
@@ -60,6 +95,7 @@ from numpy.typing import NDArray
 
 from ridempc.baselines.cassie_segway import ShiftLoop
 from ridempc.baselines.cassie_segway_gains import LoopGains
+from ridempc.mpc.manoeuvre import turn_headings
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.state_map import HEADING_SPEED
 from ridempc.mpc.statics import StaticShift
@@ -69,7 +105,8 @@ __all__ = [
     "CROUCH_DELAY",
     "CROUCH_SECONDS",
     "LEAN_GAINS",
-    "LEAN_PULL",
+    "LEAN_SECONDS",
+    "STANDING_PULL",
     "Crouch",
     "LeanSteering",
     "com_height",
@@ -85,10 +122,13 @@ LEAN_GAINS = LoopGains(
     ki=0.1,  # [m per rad]
     integral_limit=0.08,  # [m]
     max_shift=0.1,  # [m]
-    max_rate=0.1,  # [m/s]
+    # [m/s] twice the pd rider's: riding, the path takes the centre of mass there (yaw-steps
+    # seed 0 with the heading carried by the gyro, yaw-rate RMSE 0.104 at 0.1, 0.082 at 0.2)
+    max_rate=0.2,
     filter_hz=5.0,  # [Hz] on the yaw rate
 )
-LEAN_PULL: float = 8.0  # [-] the reference's offset per metre of lean (module docstring)
+LEAN_SECONDS: float = 0.2  # [s] T, the riding lean's path (module docstring)
+STANDING_PULL: float = 8.0  # [-] standing, the reference's offset per metre of lean
 
 
 def com_height(robot: Robot, qpos: Array) -> float:
@@ -143,43 +183,97 @@ class Crouch:
 
 class LeanSteering:
     """The lean loop (module docstring): the yaw rate to a sideways offset of the MPC's
-    centre-of-mass reference.
+    centre-of-mass reference, and, riding, the turn it makes told to the MPC.
 
     Args:
         gains: The loop's gains (its shift is the lean :math:`s` [m]).
-        pull: :math:`g`, the reference's offset per metre of lean [-].
+        standing_pull: Standing, the reference's offset per metre of lean [-].
+        min_speed: The board's least speed for riding [m/s].
+        seconds: :math:`T`, the riding lean's path [s].
+
+    Attributes:
+        offset: The last offset laid over the reference [m]: :math:`s` riding, ``standing_pull``
+            :math:`\\times s` standing.
+        riding: Whether the last update found the board at ``min_speed`` or more.
+        turn_rate: :math:`\\omega^*`, the yaw rate the last update followed [rad/s] (zero
+            standing).
     """
 
     def __init__(
         self,
         gains: LoopGains = LEAN_GAINS,
-        pull: float = LEAN_PULL,
+        standing_pull: float = STANDING_PULL,
         min_speed: float = HEADING_SPEED,
+        seconds: float = LEAN_SECONDS,
     ) -> None:
-        if not pull > 0.0:
-            raise ValueError(f"lean steering: pull {pull} must be positive")
+        if not standing_pull > 0.0:
+            raise ValueError(f"lean steering: standing pull {standing_pull} must be positive")
+        if not seconds > 0.0:
+            raise ValueError(f"lean steering: path time constant {seconds} s must be positive")
         self.loop = ShiftLoop(gains)
-        self.pull = pull
+        self.standing_pull = standing_pull
         self.min_speed = min_speed
-        self.offset = 0.0  # [m] the last offset laid over the reference
+        self.seconds = seconds
+        self.offset = 0.0
+        self.riding = False
+        self.turn_rate = 0.0
 
     def update(self, now: float, command: float, yaw_rate: float, speed: float) -> float:
         """The reference's offset [m] for the commanded and the estimated yaw rate
         [rad/s] at ``now`` [s] and the board's forward ``speed`` [m/s]; below ``min_speed``
         the loop holds the yaw rate at zero, whatever the command."""
-        wanted = command if abs(speed) >= self.min_speed else 0.0
-        self.offset = self.pull * self.loop(now, wanted, yaw_rate)
+        self.riding = abs(speed) >= self.min_speed
+        self.turn_rate = command if self.riding else 0.0
+        shift = self.loop(now, self.turn_rate, yaw_rate)
+        self.offset = shift if self.riding else self.standing_pull * shift
         return self.offset
 
-    def lean(self, problem: MpcProblem, index: int, balance: StaticShift | None) -> MpcProblem:
+    def lean(
+        self, problem: MpcProblem, index: int, rate: int, balance: StaticShift | None
+    ) -> MpcProblem:
         """``problem`` with its reference's state ``index`` (the CoM's y) moved by the
-        offset, and with ``balance`` (the reference's change per metre of it) moved along."""
+        offset, and with ``balance`` (the reference's change per metre of it) moved along:
+        riding, along the path from the initial state's offset to it, with the path's rate
+        on state ``rate`` (the CoM's :math:`\\dot y`); standing, by the offset at every node.
+        A zero offset leaves the problem as it is."""
         if self.offset == 0.0:
             return problem
         states = problem.state_reference.copy()
         inputs = problem.input_reference.copy()
+        nodes = states.shape[0]
+        if self.riding:
+            start = problem.initial_state[index] - problem.state_reference[0, index]
+            decay = np.exp(-np.arange(nodes) * problem.dt / self.seconds)
+            path = self.offset + (start - self.offset) * decay
+            states[:, rate] -= (start - self.offset) / self.seconds * decay
+        else:
+            path = np.full(nodes, self.offset)
         if balance is not None:
-            states += self.offset * balance.states[None, :]
-            inputs += self.offset * balance.inputs[None, :]
-        states[:, index] = problem.state_reference[:, index] + self.offset
+            states += path[:, None] * balance.states[None, :]
+            inputs += path[: inputs.shape[0], None] * balance.inputs[None, :]
+        states[:, index] = problem.state_reference[:, index] + path
         return replace(problem, state_reference=states, input_reference=inputs)
+
+    def turn(self, problem: MpcProblem, names: dict[str, int]) -> MpcProblem:
+        """Riding, ``problem`` with its reference's headings turned at the followed yaw
+        rate from the first node, :math:`\\psi_k \\mathrel{+}= \\omega^* k \\Delta t`, and
+        its yaw rates (the base's :math:`\\omega_z`, the board's) raised by it
+        (:func:`~ridempc.mpc.manoeuvre.turn_headings`); as it is standing or not turning."""
+        if not self.riding or self.turn_rate == 0.0:
+            return problem
+        states = problem.state_reference.copy()
+        nodes = states.shape[0]
+        turned = np.asarray(self.turn_rate * problem.dt * np.arange(nodes), dtype=np.float64)
+        turn_headings(states, names, turned, np.full(nodes, self.turn_rate))
+        return replace(problem, state_reference=states)
+
+    def drift(self, nx: int, rate: int, speed: float, yaw_rate: float) -> Array | None:
+        """Riding, the centrifugal acceleration of the frame that turns with the board as
+        a drift of the MPC's rates (nx), :math:`-v \\hat\\omega` [m/s²] on state ``rate``
+        (the CoM's :math:`\\dot y`) for the board's ``speed`` :math:`v` [m/s] and the
+        estimated ``yaw_rate`` :math:`\\hat\\omega` [rad/s]; None standing."""
+        if not self.riding:
+            return None
+        drift = np.zeros(nx)
+        drift[rate] = -speed * yaw_rate
+        return drift

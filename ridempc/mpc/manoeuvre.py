@@ -58,6 +58,7 @@ __all__ = [
     "Manoeuvre",
     "ManoeuvreSelector",
     "StateLayout",
+    "turn_headings",
 ]
 
 Array = NDArray[np.float64]
@@ -71,6 +72,18 @@ RETARGET_BAND: float = 0.25
 # Name endings of a board platform's yaw-rate states (the Hovershoes' and the Segway's).
 YAW_RATE_SUFFIXES: tuple[str, ...] = ("_psi_dot", "_yaw_rate")
 HEADING_SUFFIXES: tuple[str, ...] = ("_yaw", "_psi")  # the base's and the platforms' headings
+
+
+def turn_headings(states: Array, names: dict[str, int], turned: Array, rates: Array) -> None:
+    """Turn a reference's headings and yaw rates in place, node by node: every heading (the
+    base's yaw, the platforms' ``*_yaw``, ``*_psi``) gains ``turned`` [rad] and every yaw
+    rate (the base's :math:`\\omega_z`, the platforms' ``*_psi_dot``, ``*_yaw_rate``)
+    gains ``rates`` [rad/s], both (nodes,)."""
+    for name, index in names.items():
+        if name.endswith(HEADING_SUFFIXES):
+            states[:, index] += turned
+        elif name.endswith(YAW_RATE_SUFFIXES) or name == "wz":
+            states[:, index] += rates
 
 
 @dataclass(frozen=True)
@@ -325,11 +338,7 @@ class ManoeuvreSelector:
         states[:, com] = turned_centre
         velocity = [names["vx"], names["vy"]]
         states[:, velocity] = turn(states[:, velocity])
-        for name, index in names.items():
-            if name.endswith(HEADING_SUFFIXES):
-                states[:, index] += turned_k
-            elif name.endswith(YAW_RATE_SUFFIXES) or name == "wz":
-                states[:, index] += step_rates
+        turn_headings(states, names, turned_k, step_rates)
         return replace(problem, state_reference=states)
 
     @staticmethod

@@ -17,7 +17,9 @@ Every 2 ms (500 Hz) the rider
    replaces the reference's roll, and on the skateboard turns the reference's heading at
    the rate the roll steers (eq. 14); on the Segway, whose knee bar the plan cannot push,
    the rider crouches into the robot's riding keyframe and leans into the bar: a yaw-rate
-   loop moves the reference's centre of mass sideways (:mod:`ridempc.mpc.lean`);
+   loop moves the reference's centre of mass sideways, and riding, the reference's
+   headings and the heading the frame follows turn at the commanded rate and the frame's
+   turn pulls the centre of mass outwards in the plan (:mod:`ridempc.mpc.lean`);
    on the Hovershoes the MPC also sees where each foot stands along its shoe and each
    shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
    :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, each shoe's heading is
@@ -125,6 +127,11 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
 WBC_GRACE_TICKS: int = 5
+
+
+def _base_yaw_rate(estimate: EstimatedState) -> float:
+    """The base's yaw rate, world z of the estimated angular velocity [rad/s]."""
+    return float((estimate.rotation @ estimate.base_angular_velocity)[2])
 
 
 def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
@@ -426,10 +433,19 @@ class MpcRider(Controller):
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
-        self._follow_board(mapped, here, turn, now, coasting)
+        yaw_rate = _base_yaw_rate(estimate)
+        if self.lean is not None:
+            self.lean.update(now, command.yaw_rate, yaw_rate, speed)
+        carried = self.lean.turn_rate if self.lean is not None else 0.0
+        self._follow_board(mapped, here, turn, now, coasting, carried)
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
-        problem = self.mpc.problem(t_ref, x0, self._roll_drift(x0, now, balancing, estimate))
+        drift = self._roll_drift(x0, now, balancing, estimate)
+        if self.lean is not None:
+            centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
+            if centrifugal is not None:
+                drift = centrifugal if drift is None else drift + centrifugal
+        problem = self.mpc.problem(t_ref, x0, drift)
         if coasting:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
@@ -440,9 +456,10 @@ class MpcRider(Controller):
         if self.crouch is not None:
             problem = self.crouch.lower(problem, names["com_z"], now)
         if self.lean is not None:
-            yaw_rate = float((estimate.rotation @ estimate.base_angular_velocity)[2])
-            if self.lean.update(now, command.yaw_rate, yaw_rate, speed) != 0.0:
-                problem = self.lean.lean(problem, names["com_y"], self._lean_balance(t_ref))
+            if self.lean.offset != 0.0:
+                balance = self._lean_balance(t_ref)
+                problem = self.lean.lean(problem, names["com_y"], names["vy"], balance)
+            problem = self.lean.turn(problem, names)
             self._diagnostics["lean_offset"] = self.lean.offset
         if self.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
@@ -586,20 +603,31 @@ class MpcRider(Controller):
         )
 
     def _follow_board(
-        self, estimate: EstimatedState, reference: Array, turn: Array, now: float, coasting: bool
+        self,
+        estimate: EstimatedState,
+        reference: Array,
+        turn: Array,
+        now: float,
+        coasting: bool,
+        yaw_rate: float,
     ) -> None:
         """Integrate the commanded turn and move the library frame onto the board (the
         ``reference`` state of this tick): across the reference's line (turned by the turn
         so far), along it by what lies beyond :data:`~ridempc.mpc.state_map.ALONG_SLACK`,
         and all along it while turning or coasting (the reference's steady ride is not
-        where a coasting board goes)."""
+        where a coasting board goes); on a board whose heading the frame follows, that
+        heading carried by ``yaw_rate`` [rad/s], the turn the rider is making."""
         if self._turn_time is not None:
             self._turned += self._turn_rate * (now - self._turn_time)
         self._turn_time, self._turn_rate = now, float(turn[0])
         x, y, heading = self.layout.board_pose(reference)
         along = coasting or bool(np.any(turn)) or self._turned != 0.0
         self.map.follow_sideways(
-            estimate, (x, y, heading + self._turned), along=along, heading=self._follows_heading
+            estimate,
+            (x, y, heading + self._turned),
+            along=along,
+            heading=self._follows_heading,
+            yaw_rate=yaw_rate,
         )
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:

@@ -274,6 +274,7 @@ class StateMap:
         along: bool = False,
         heading: bool = False,
         slack: float = ALONG_SLACK,
+        yaw_rate: float = 0.0,
     ) -> float:
         """Shift the frame across the reference's heading so that platform 0's estimate
         lies on the reference's line: its cross-track offset
@@ -312,6 +313,34 @@ class StateMap:
         yaw is the rider's (two feet side by side), and following it let the rider's yaw run
         off. Below ``HEADING_SPEED`` the frame does not turn.
 
+        The followed heading is a complementary filter: over a tick of :math:`\\Delta t`
+        the frame's yaw :math:`\\psi_f` is first carried by the turn rate ``yaw_rate``
+        :math:`\\omega` [rad/s] (the rider's: the turn she commands), then drawn towards
+        the direction of travel :math:`\\psi_{tr}`,
+
+        .. math:: \\psi^- = \\psi_f + \\omega \\Delta t, \\qquad
+            \\psi_f \\leftarrow \\psi^- + \\min(1, \\Delta t / T)\\,
+            \\operatorname{wrap}(\\psi_{tr} - \\psi^-)
+
+        with :math:`T` = ``HEADING_FILTER_S``: the travel sets the heading, the turn its
+        changes. The low-pass alone lags a steady turn by :math:`\\omega T`, 0.15 rad at
+        0.5 rad/s, and the MPC, holding the rider's pelvis and velocity on the lagging
+        heading, leaned her out of the turn she was leaning into (Segway yaw-steps, seed
+        0, the lean loop of before, :mod:`~ridempc.mpc.lean`: it held 0.5 rad/s with 0.35 m
+        of reference offset; carried by the base gyro's yaw rate, with 0.12 m). The gyro
+        carries the rider's own yaw into the frame her yaw is held in: riding straight
+        (velocity-steps) her pelvis wandered up to 0.14 rad off the board, 0.016 rad
+        carried by the commanded turn.
+
+        Args:
+            estimate: The state estimate.
+            board_pose: The reference's platform 0 :math:`(x, y, \\psi)` [m, m, rad].
+            along: Take out the offset along the line too.
+            heading: Turn the frame onto platform 0's direction of travel.
+            slack: :math:`s` [m].
+            yaw_rate: :math:`\\omega` [rad/s], the turn that carries the followed heading
+                (0: the plain low-pass).
+
         Returns:
             The shift :math:`e` [m] (0 without a board estimate).
         """
@@ -325,8 +354,10 @@ class StateMap:
             if forward_speed(board) < 0.0:
                 travel = wrap_angle(travel + math.pi)
             wanted = wrap_angle(travel - yaw_ref)
-            share = min(1.0, (estimate.time - self._heading_time) / HEADING_FILTER_S)
-            yaw = self.frame.yaw + share * wrap_angle(wanted - self.frame.yaw)
+            step = estimate.time - self._heading_time
+            share = min(1.0, step / HEADING_FILTER_S)
+            carried = self.frame.yaw + yaw_rate * step
+            yaw = carried + share * wrap_angle(wanted - carried)
             kept = self.frame.point_to_library(board.position)
             self.frame = PlanarFrame.through(yaw, kept, board.position)
         self._heading_time = estimate.time
