@@ -315,27 +315,33 @@ def test_a_stance_with_a_foot_landed_inward_rides_a_cut_roll_wave(dog) -> None:
     assert rider.stance is not None and rider.stance.last[1] < 0.1  # the wave was cut
 
 
-def test_the_hovershoes_rider_reads_a_planned_speed_over_its_horizon() -> None:
+def test_the_cassie_riders_read_a_planned_speed_over_their_horizon(dog) -> None:
     """velocity-steps plans 0.5 m/s from 3.0 s: where the commands are planned, the
-    Hovershoes' manoeuvre follows the speed planned for the end of the MPC's horizon
-    (0.4 s), so from 2.6 s; without a plan, or on the Segway, the command of the moment."""
+    Hovershoes' (and the Segway's) manoeuvre follows the speed planned for the end of the
+    MPC's horizon (0.4 s), so from 2.6 s; without a plan, or on the skateboard (whose
+    push-offs are judged from their command), the command of the moment."""
     cassie = load_robot("cassie")
-    shoes, segway = MpcRider(cassie, "hovershoes"), MpcRider(cassie, "segway")
+    shoes, segway, skate = (
+        MpcRider(cassie, "hovershoes"),
+        MpcRider(cassie, "segway"),
+        MpcRider(dog, "skateboard"),
+    )
     scenario = resolve_scenario("velocity-steps", "hovershoes")
     horizon = shoes.mpc.settings.horizon * shoes.mpc.settings.dt
     assert horizon == pytest.approx(0.4)
     now = scenario.command_at(2.7)
     assert now.velocity == 0.0
     assert shoes._speed_command(now, 2.7).velocity == 0.0  # no plan given yet
-    for rider in (shoes, segway):
+    for rider in (shoes, segway, skate):
         rider.command_preview = scenario.command_at
     assert shoes._speed_command(now, 2.7).velocity == 0.5
+    assert segway._speed_command(now, 2.7).velocity == 0.5
     ahead = shoes._speed_command(now, 2.7)
     assert ahead.yaw_rate == now.yaw_rate  # only the speed is read ahead
     assert shoes._speed_command(scenario.command_at(2.55), 2.55).velocity == 0.0
-    assert segway._speed_command(now, 2.7).velocity == 0.0  # the Segway does not preview
+    assert skate._speed_command(now, 2.7).velocity == 0.0  # the skateboard does not preview
     assert shoes.summary()["speed_preview_s"] == pytest.approx(0.4)  # the summary says so
-    assert segway.summary()["speed_preview_s"] == 0.0
+    assert skate.summary()["speed_preview_s"] == 0.0
 
 
 def test_cassie_leans_into_a_planned_speed_step_on_the_hovershoes() -> None:
