@@ -163,7 +163,7 @@ class CassieHovershoes(CassieStanding):
         yaw = estimate.yaw
         heading = np.array([np.cos(yaw), np.sin(yaw)])
         speed = float(heading @ estimate.base_velocity[:2])
-        yaw_rate = float((estimate.rotation @ estimate.base_angular_velocity)[2])
+        yaw_rate = estimate.yaw_rate
         self._speed = float(self._speed_filter(time, np.array([speed]))[0])
         self._yaw_rate = float(self._yaw_rate_filter(time, np.array([yaw_rate]))[0])
         return self._speed, self._yaw_rate

@@ -178,11 +178,6 @@ class CassieSegway(CassieStanding):
         yaw = estimate.yaw
         return float(np.cos(yaw) * velocity[0] + np.sin(yaw) * velocity[1])
 
-    @staticmethod
-    def yaw_rate(estimate: EstimatedState) -> float:
-        """The base's yaw rate, world z of the estimated angular velocity [rad/s]."""
-        return float((estimate.rotation @ estimate.base_angular_velocity)[2])
-
     def posture(self, time: float) -> tuple[float, float]:
         """Step 1: the mean leg length [m] and outward hip roll [rad] at ``time`` [s].
 
@@ -207,7 +202,7 @@ class CassieSegway(CassieStanding):
         if estimate is None:
             return nominal
         shift_x = self.velocity_loop(state.time, command.velocity, self.forward_speed(estimate))
-        shift_y = self.turning_loop(state.time, command.yaw_rate, self.yaw_rate(estimate))
+        shift_y = self.turning_loop(state.time, command.yaw_rate, estimate.yaw_rate)
         self._diagnostics.update(
             speed_estimate=self.velocity_loop.measured,
             yaw_rate_estimate=self.turning_loop.measured,

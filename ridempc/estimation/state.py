@@ -133,3 +133,8 @@ class EstimatedState:
     def rotation(self) -> Array:
         """:math:`R_{WB}` [3 x 3]."""
         return quaternion_to_matrix(self.base_quaternion)
+
+    @property
+    def yaw_rate(self) -> float:
+        """The base's yaw rate, world z of the estimated angular velocity [rad/s]."""
+        return float((self.rotation @ self.base_angular_velocity)[2])

@@ -129,11 +129,6 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 WBC_GRACE_TICKS: int = 5
 
 
-def _base_yaw_rate(estimate: EstimatedState) -> float:
-    """The base's yaw rate, world z of the estimated angular velocity [rad/s]."""
-    return float((estimate.rotation @ estimate.base_angular_velocity)[2])
-
-
 def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
     """Feet per platform: one each when the board has a platform per foot, else all on one."""
     feet = robot.params.foot_bodies
@@ -433,7 +428,7 @@ class MpcRider(Controller):
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
-        yaw_rate = _base_yaw_rate(estimate)
+        yaw_rate = estimate.yaw_rate
         if self.lean is not None:
             self.lean.update(now, command.yaw_rate, yaw_rate, speed)
         carried = self.lean.turn_rate if self.lean is not None else 0.0
