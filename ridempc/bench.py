@@ -13,8 +13,11 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    table says how many. The ride's wall time is split into its **budget**, the mean wall
    time per control tick [ms] (the real-time budget is the tick's 2 ms): the simulation
    (physics at 1500 Hz, sensors, the board's firmware, the motor drivers, the judge's log)
-   and the rider's estimator, MPC (its 30 Hz ticks spread over the 500 Hz ones), WBC
-   (model, contacts, QP) and the rest of the rider's tick.
+   and the rider's estimator, MPC (its 30 Hz ticks spread over the 500 Hz ones: the time
+   they take in the loop's own thread, building each problem, starting and finishing its
+   solve, and waiting for a solve still running when its plan is due; OSQP's iterations
+   run in a thread beside the loop), WBC (model, contacts, QP) and the rest of the rider's
+   tick.
 2. **MPC.** The recorded problems are solved again in order by a fresh
    :class:`~ridempc.mpc.qp.MpcQP` (OSQP, built once, updated in place, warm-started):
    median and p99 of the update-and-solve time [ms].
@@ -108,20 +111,20 @@ def _scenario_of(pair: str, scenario: str | None) -> str:
 BUDGET_PARTS: tuple[str, ...] = ("simulation", "estimator", "mpc", "wbc", "rider_rest")
 
 
-def _budget(result: Any, parts: dict[str, float], mpc_ms: Sequence[float]) -> dict[str, float]:
+def _budget(result: Any, parts: dict[str, float], mpc: float) -> dict[str, float]:
     """The ride's mean wall time per control tick [ms], whole (``loop``) and by part
     (:data:`BUDGET_PARTS`; module docstring).
 
     Args:
         result: The ride (its loop's wall time and each rider update's time [s]).
         parts: Seconds spent in the estimator and in the WBC over the ride.
-        mpc_ms: Each MPC tick's time [ms] (inside the rider's updates).
+        mpc: Seconds the MPC spent in the control loop's thread (inside the rider's
+            updates; its solves run in a thread of their own).
     """
     ticks = len(result.controller_times)
     if ticks == 0:
         return {}
     rider = float(np.sum(result.controller_times))
-    mpc = 1e-3 * float(np.sum(mpc_ms))
     spent = {
         "simulation": result.wall_time - rider,
         "estimator": parts["estimator"],
@@ -180,7 +183,7 @@ def _record(
     scenario = resolve_scenario(scenario_name, board_name).with_duration(seconds)
     scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=load_board(board_name))
     result = Simulation(scene, rider, scenario).run()
-    return result, problems, wbc_inputs, rider, _budget(result, parts, rider.mpc_tick_ms)
+    return result, problems, wbc_inputs, rider, _budget(result, parts, rider.mpc_loop_seconds)
 
 
 def _as_qpsolvers(

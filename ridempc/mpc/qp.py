@@ -46,7 +46,14 @@ from numpy.typing import NDArray
 from ridempc.mpc.plan import Plan, shift_plan
 from ridempc.mpc.problem import MpcProblem
 
-__all__ = ["DEFAULT_SETTINGS", "MpcQP", "QPStructure", "SolveRecord"]
+__all__ = [
+    "DEFAULT_SETTINGS",
+    "MpcQP",
+    "QPStructure",
+    "SolveOutcome",
+    "SolveRecord",
+    "StartedSolve",
+]
 
 Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -111,6 +118,26 @@ class SolveRecord(NamedTuple):
     solve_time: float
     iterations: int
     fallback: bool
+
+
+class StartedSolve(NamedTuple):
+    """A QP updated and warm-started (:meth:`MpcQP.start`): its problem, the reference
+    :math:`z^{ref}` it is solved about, and the time that took [s]."""
+
+    problem: MpcProblem
+    reference: Array
+    seconds: float
+
+
+class SolveOutcome(NamedTuple):
+    """OSQP's run (:meth:`MpcQP.run`): its result (None on a solver error), status,
+    iterations, whether it solved, and its time [s]."""
+
+    result: Any
+    status: str
+    iterations: int
+    ok: bool
+    seconds: float
 
 
 class MpcQP:
@@ -390,7 +417,18 @@ class MpcQP:
         Raises:
             ValueError: As :meth:`update`.
         """
-        start = time.perf_counter()
+        started = self.start(problem)
+        return self.finish(started, self.run())
+
+    def start(self, problem: MpcProblem) -> StartedSolve:
+        """The first part of :meth:`solve`: the QP updated with ``problem`` and warm-started.
+        :meth:`run` then solves it (OSQP releases Python's lock while it iterates, so that
+        may go on in another thread) and :meth:`finish` turns the outcome into the plan.
+
+        Raises:
+            ValueError: As :meth:`update`.
+        """
+        begin = time.perf_counter()
         self.update(problem)
         reference = self._reference(problem)
         if self._previous is not None:
@@ -398,22 +436,38 @@ class MpcQP:
             z = np.concatenate([states.ravel(), inputs.ravel()])[self._primal_shift]
             y = None if self._previous_dual is None else self._previous_dual[self._dual_shift]
             self._solver.warm_start(x=(z - reference) / self._scale, y=y)
+        return StartedSolve(problem, reference, time.perf_counter() - begin)
+
+    def run(self) -> SolveOutcome:
+        """OSQP's solve of the started QP (:meth:`start`); never raises."""
+        begin = time.perf_counter()
         try:
             result = self._solver.solve(raise_error=False)
             status, iterations = str(result.info.status), int(result.info.iter)
             ok = result.info.status_val == _SOLVED
         except (osqp.OSQPException, ValueError) as exc:
-            status, iterations, ok = f"solver error ({exc!r})", 0, False
-        elapsed = time.perf_counter() - start
+            result, status, iterations, ok = None, f"solver error ({exc!r})", 0, False
+        return SolveOutcome(result, status, iterations, ok, time.perf_counter() - begin)
+
+    def finish(self, started: StartedSolve, outcome: SolveOutcome) -> Plan:
+        """The plan of a started (:meth:`start`) and run (:meth:`run`) solve, or the
+        fallback (:meth:`solve`). Its ``solve_time`` is the time spent in :meth:`start`,
+        :meth:`run` and here, not the wall time between them."""
+        begin = time.perf_counter()
+        status, iterations, ok = outcome.status, outcome.iterations, outcome.ok
+        elapsed = started.seconds + outcome.seconds
         if ok and self.time_limit is not None and elapsed > self.time_limit:
             status, ok = f"time limit exceeded ({elapsed * 1e3:.1f} ms)", False
+        problem, result = started.problem, outcome.result
         if ok:
-            z = reference + self._scale * np.asarray(result.x, dtype=float)
+            z = started.reference + self._scale * np.asarray(result.x, dtype=float)
             states, inputs = self._unpack(z)
+            elapsed += time.perf_counter() - begin
             plan = Plan(states, inputs, inputs[0].copy(), status, elapsed, False, iterations)
             self._previous_dual = np.asarray(result.y, dtype=float).copy()
         else:
             self.failures += 1
+            elapsed += time.perf_counter() - begin
             if self._previous is not None:
                 plan = shift_plan(self._previous, status, elapsed, iterations)
             else:

@@ -9,7 +9,10 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`) on the manoeuvre the command asks for
+   (:class:`~ridempc.mpc.controller.LinearMpc`; OSQP iterates in a thread of its own, as the
+   robots run their MPC beside their WBC, and the plan takes over ``plan_latency`` ticks,
+   2 ms, after the state it starts from, waited for then whatever the machine: the ticks
+   between follow the previous plan) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
@@ -63,8 +66,9 @@ from __future__ import annotations
 
 import math
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -93,6 +97,7 @@ from ridempc.mpc.manoeuvre import (
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.qp import SolveOutcome, StartedSolve
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
@@ -127,6 +132,23 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
 WBC_GRACE_TICKS: int = 5
+# Control ticks from the state an MPC solve starts from to the tick its plan takes over
+# (2 ms): the solve runs in a thread of its own meanwhile, as on the robots, where the MPC
+# and the WBC are separate loops, and the ticks go on following the previous plan.
+# Waited for at that tick, never skipped, so that a ride does not depend on the machine.
+PLAN_LATENCY_TICKS: int = 1
+
+
+class _PendingSolve(NamedTuple):
+    """An MPC solve under way: the started QP, the time of the state it starts from [s],
+    the tick its plan takes over, the time spent building the problem [s], and the
+    solver thread's future (None when solved in the tick)."""
+
+    started: StartedSolve
+    time: float
+    due: int
+    build_s: float
+    future: Future[SolveOutcome] | None = None
 
 
 def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
@@ -188,8 +210,14 @@ class MpcRider(Controller):
         board: str,
         settings: MpcSettings | None = None,
         wbc_solver: str = "osqp",
+        plan_latency: int = PLAN_LATENCY_TICKS,
     ) -> None:
         super().__init__(robot, board)
+        if plan_latency < 0 or plan_latency >= MPC_DIVIDER:
+            raise ValueError(
+                f"plan_latency must be 0 to {MPC_DIVIDER - 1} ticks, got {plan_latency}"
+            )
+        self.plan_latency = plan_latency
         from ridempc.boards import load_board
 
         self.pair = load_mpc_pair(robot.name, board)
@@ -309,6 +337,9 @@ class MpcRider(Controller):
         self._hold_reason: str | None = None
         self._hold_time: float | None = None
         self._mpc_ms: list[float] = []
+        self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
+        self._pending: _PendingSolve | None = None
+        self._worker: ThreadPoolExecutor | None = None
         self._wbc_ms: list[float] = []
         self._diagnostics: dict[str, float] = {}
 
@@ -382,6 +413,8 @@ class MpcRider(Controller):
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
+            if self._pending is not None and self._tick >= self._pending.due:
+                self._adopt_pending()
             out = self._wbc_tick(estimate, sensors.time)
         except WbcFailed as exc:
             if self._last_command is None or self._wbc_misses >= WBC_GRACE_TICKS:
@@ -467,14 +500,39 @@ class MpcRider(Controller):
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem
-        plan = self.mpc.qp.solve(problem)
-        self._mpc_ms.append(1e3 * (time.perf_counter() - started))
+        build = time.perf_counter() - started
+        solve = _PendingSolve(
+            self.mpc.qp.start(problem), now, self._tick + self.plan_latency, build
+        )
+        if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
+            self._adopt(solve, self.mpc.qp.run())
+        else:
+            if self._worker is None:
+                self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mpc")
+            self._pending = solve._replace(future=self._worker.submit(self.mpc.qp.run))
+        self._mpc_main_s += time.perf_counter() - started
+
+    def _adopt_pending(self) -> None:
+        """The pending solve's plan taken up, once its tick has come (waiting for it if
+        the solver is still at it)."""
+        solve, self._pending = self._pending, None
+        assert solve is not None and solve.future is not None
+        started = time.perf_counter()
+        self._adopt(solve, solve.future.result())
+        self._mpc_main_s += time.perf_counter() - started
+
+    def _adopt(self, solve: _PendingSolve, outcome: SolveOutcome) -> None:
+        """The plan of ``solve`` (OSQP's ``outcome``) in force from this tick on, timed
+        from the state it was solved from."""
+        assert self.mpc.qp is not None
+        plan = self.mpc.qp.finish(solve.started, outcome)
+        self._mpc_ms.append(1e3 * (solve.build_s + plan.solve_time))
         if not np.all(np.isfinite(plan.states)):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
         if self.force_filter is not None:
-            plan = plan._replace(first_input=self.force_filter(plan.first_input, now))
-        self._plan, self._plan_time = plan, now
-        self._set_support(problem.contacts[0])
+            plan = plan._replace(first_input=self.force_filter(plan.first_input, solve.time))
+        self._plan, self._plan_time = plan, solve.time
+        self._set_support(solve.started.problem.contacts[0])
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
             mpc_fallback=float(plan.fallback),
@@ -786,8 +844,15 @@ class MpcRider(Controller):
 
     @property
     def mpc_tick_ms(self) -> tuple[float, ...]:
-        """Each MPC tick's wall time so far [ms]: building the problem and solving it."""
+        """Each MPC tick's time so far [ms]: building the problem and solving it (the
+        solve's own time, not the ticks it runs alongside)."""
         return tuple(self._mpc_ms)
+
+    @property
+    def mpc_loop_seconds(self) -> float:
+        """The MPC's time in the control loop's thread so far [s]: building, starting and
+        finishing its solves, and waiting for one still running when its tick comes."""
+        return self._mpc_main_s
 
     def summary(self) -> dict[str, Any]:
         """Solve times, fallbacks and the safe hold, for ``summary.json``."""
