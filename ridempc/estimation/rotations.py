@@ -54,7 +54,7 @@ def matrix_to_quaternion(rotation: Array) -> Array:
         quat[1 + i] = 0.25 * s
         quat[1 + j] = (m[j, i] + m[i, j]) / s
         quat[1 + k] = (m[k, i] + m[i, k]) / s
-    quat /= np.linalg.norm(quat)
+    quat /= math.sqrt(quat.dot(quat))  # np.linalg.norm's sum, without its wrapper
     return quat if quat[0] >= 0.0 else -quat
 
 

@@ -405,7 +405,7 @@ class MpcRider(Controller):
             self.estimator.update(sensors)
         estimate = self.estimator.state
         if estimate is None or not (
-            np.all(np.isfinite(estimate.q)) and np.all(np.isfinite(estimate.v))
+            np.isfinite(estimate.q).all() and np.isfinite(estimate.v).all()
         ):
             return self._safe_hold(sensors, f"state estimate not finite at {sensors.time:.3f} s")
         if self.shoe_heading is not None:

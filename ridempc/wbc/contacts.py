@@ -148,7 +148,7 @@ def build_contact_set(
     names = tuple(foot_names)
     active = np.asarray(contact, dtype=bool)[site_foot]
     n = len(site_foot)
-    frame = np.repeat(_AXES[None], n, axis=0)
+    frame = _AXES[None].repeat(n, axis=0)
     acceleration = np.zeros((n, 3))
     coupling: Array | None = None
     tipping: list[tuple[Index, Array, Array]] = []

@@ -305,6 +305,12 @@ def to_motor_command(output: WbcOutput, kp: Array | float, kd: Array | float) ->
         torque=output.torque.copy(),
         position=output.position.copy(),
         velocity=output.velocity.copy(),
-        kp=np.broadcast_to(np.asarray(kp, dtype=float), (n,)).copy(),
-        kd=np.broadcast_to(np.asarray(kd, dtype=float), (n,)).copy(),
+        kp=_per_motor(kp, n),
+        kd=_per_motor(kd, n),
     )
+
+
+def _per_motor(gain: Array | float, n: int) -> Array:
+    """A copy of ``gain``, one per motor (a scalar repeated)."""
+    gain = np.asarray(gain, dtype=float)
+    return gain.copy() if gain.shape == (n,) else np.broadcast_to(gain, (n,)).copy()

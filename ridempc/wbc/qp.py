@@ -361,7 +361,7 @@ class WholeBodyQP:
     @staticmethod
     def _accepted(result: OsqpResult) -> bool:
         """OSQP's status is accepted and its solution finite."""
-        return result.status in ACCEPTED and bool(np.all(np.isfinite(result.x)))
+        return result.status in ACCEPTED and bool(np.isfinite(result.x).all())
 
     def _refine(self, problem: QpProblem, x: Array) -> tuple[Array, bool]:
         """Move an unpolished ADMM solution onto its active set exactly.

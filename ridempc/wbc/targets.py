@@ -9,6 +9,7 @@ arrays follow the actuator order (``Robot.motors``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,8 +27,8 @@ def _zeros3() -> Array:
 
 
 def _check_shape(name: str, value: object, shape: tuple[int, ...]) -> None:
-    array = np.asarray(value)
-    if array.shape != shape or not np.all(np.isfinite(array)):
+    array = value if isinstance(value, np.ndarray) else np.asarray(value)
+    if array.shape != shape or not np.isfinite(array).all():
         raise ConfigError(
             f"WBC targets: field '{name}': expected finite values of shape {shape}, "
             f"got shape {array.shape}"
@@ -88,12 +89,13 @@ class WbcTargets:
             _check_shape(name, getattr(self, name), (3,))
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
         _check_shape("orientation", self.orientation, (4,))
-        norm = float(np.linalg.norm(self.orientation))
+        orientation = np.asarray(self.orientation, dtype=float)
+        norm = math.sqrt(orientation.dot(orientation))  # np.linalg.norm's sum
         if abs(norm - 1.0) > 1e-3:
             raise ConfigError(
                 f"WBC targets: field 'orientation': not a unit quaternion (norm {norm:.6f})"
             )
-        object.__setattr__(self, "orientation", np.asarray(self.orientation, dtype=float) / norm)
+        object.__setattr__(self, "orientation", orientation / norm)
         feet = len(np.asarray(self.contact))
         _check_shape("forces", self.forces, (feet, 3))
         for name in ("swing_position", "swing_velocity", "swing_acceleration"):
