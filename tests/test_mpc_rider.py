@@ -12,7 +12,8 @@ import pytest
 from ridempc.boards import load_board
 from ridempc.cli import main
 from ridempc.estimation import BoardEstimate, EstimatedState
-from ridempc.mpc.rider import MPC_DIVIDER, PLAN_LATENCY_TICKS, WBC_GRACE_TICKS, MpcRider
+from ridempc.mpc.pairs import load_mpc_pair
+from ridempc.mpc.rider import MPC_DIVIDER, WBC_GRACE_TICKS, MpcRider
 from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S, StateMap
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -37,14 +38,17 @@ def _ride(dog, duration: float, rider: MpcRider | None = None):
 
 
 def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog) -> None:
-    """The MPC solves in a thread of its own: a plan takes over ``plan_latency`` ticks after
-    the state it starts from (the first at once), timed from that state; the ticks between
-    follow the previous plan. The ride does not depend on how fast the thread runs: two
-    rides are the same, bit for bit."""
-    assert PLAN_LATENCY_TICKS == 1
+    """With ``plan_latency`` 1 the MPC solves in a thread of its own: a plan takes over one
+    tick after the state it starts from (the first at once), timed from that state; the
+    ticks between follow the previous plan. The ride does not depend on how fast the thread
+    runs: two rides are the same, bit for bit. The Hovershoes ride so; the skateboard and
+    the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
+    assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
+    assert load_mpc_pair("cassie", "segway").plan_latency == 0
+    assert MpcRider(dog, "skateboard").plan_latency == 0
     with pytest.raises(ValueError, match="plan_latency"):
         MpcRider(dog, "skateboard", plan_latency=MPC_DIVIDER)
-    rider = MpcRider(dog, "skateboard")
+    rider = MpcRider(dog, "skateboard", plan_latency=1)
     taken: list[tuple[int, float, float]] = []  # tick, time of its state, plan's time
     adopt = rider._adopt
 
@@ -55,14 +59,12 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     rider._adopt = adopting
     first, _ = _ride(dog, 0.2, rider)
     assert first.status == "ok"
-    assert [tick for tick, *_ in taken] == [0] + [
-        k * MPC_DIVIDER + PLAN_LATENCY_TICKS for k in range(1, len(taken))
-    ]
+    assert [tick for tick, *_ in taken] == [0] + [k * MPC_DIVIDER + 1 for k in range(1, len(taken))]
     assert all(state == plan for _, state, plan in taken)
     assert len(rider.mpc_tick_ms) == len(taken) and rider.mpc_loop_seconds > 0.0
-    again, _ = _ride(dog, 0.2)
+    again, _ = _ride(dog, 0.2, MpcRider(dog, "skateboard", plan_latency=1))
     np.testing.assert_array_equal(again.log["qpos"], first.log["qpos"])
-    at_once, _ = _ride(dog, 0.2, MpcRider(dog, "skateboard", plan_latency=0))
+    at_once, _ = _ride(dog, 0.2)
     assert at_once.status == "ok"
     assert np.abs(at_once.log["qpos"][-1] - first.log["qpos"][-1]).max() > 0.0  # it is used
 

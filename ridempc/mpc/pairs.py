@@ -132,6 +132,19 @@ class MpcPair(NamedTuple):
             0.0608/0.0604 -> 0.0611/0.0605 rad/s, circle 0.0276 either way (its speed RMSE
             0.0223 -> 0.0215), push 0.0327 m/s either way. False on the skateboard, whose
             push-offs are judged from their command.
+        plan_latency: Control ticks (2 ms each) from the state an MPC solve starts from to
+            the tick its plan takes over (:class:`~ridempc.mpc.rider.MpcRider`): with 1,
+            OSQP iterates in a thread beside the control loop, as on the robots; with 0
+            the loop waits for it in the tick. 1 on the Hovershoes, where the loop needs the
+            thread to keep to real time (velocity-steps, 6 s: 2.04 -> 1.98 ms a tick, real-
+            time factor 0.98 -> 1.01) and every ride checked rides with it (seeds 0-7 of
+            velocity-steps, yaw-steps, push and offset-start). 0 on the Segway: its ride
+            from a standstill, seed 6, fell at 1.7-3.0 s with the plan a tick late (push,
+            velocity-steps, yaw-steps, stand-still; the platform rings at the start, and
+            the delay feeds it), where seeds 0-5 and 7 rode and the PD rides seed 6. 0 on
+            the skateboard: with it, push-off-1.0 fell on seeds 1, 13, 14 and 15 of 0-15,
+            against 12, 13 and 14 without: the push-offs are fragile either way (the
+            trunk tips towards the pushing foot before it lands), the delay no cure.
     """
 
     pair: Pair
@@ -151,6 +164,7 @@ class MpcPair(NamedTuple):
     push_max_target: float = math.inf
     stance_roll: float | None = None
     speed_preview: bool = False
+    plan_latency: int = 0
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -192,6 +206,7 @@ def _ride(
     terminal_factor: float = 10.0,
     start_speed: float = 0.0,
     speed_preview: bool = False,
+    plan_latency: int = 0,
 ) -> MpcPair:
     rider, wheeled = ride_models(robot, board)
     layout = ride_layout(rider, wheeled)
@@ -225,6 +240,7 @@ def _ride(
         terminal_factor,
         start_speed,
         speed_preview=speed_preview,
+        plan_latency=plan_latency,
     )
 
 
@@ -239,6 +255,7 @@ MPC_PAIRS: dict[str, Callable[[], MpcPair]] = {
         terminal_factor=30.0,
         start_speed=0.06,
         speed_preview=True,
+        plan_latency=1,
     ),
     "cassie-segway": partial(_ride, "cassie", "segway", speed_preview=True),
 }

@@ -9,10 +9,11 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; OSQP iterates in a thread of its own, as the
-   robots run their MPC beside their WBC, and the plan takes over ``plan_latency`` ticks,
-   2 ms, after the state it starts from, waited for then whatever the machine: the ticks
-   between follow the previous plan) on the manoeuvre the command asks for
+   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes OSQP iterates in a thread
+   of its own, as the robots run their MPC beside their WBC, and the plan takes over one
+   tick, 2 ms, after the state it starts from, waited for then whatever the machine, the
+   tick between following the previous plan in its own library frame: the pair's
+   ``plan_latency``) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
@@ -102,7 +103,7 @@ from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.stance import StanceLimit
-from ridempc.mpc.state_map import StateMap, forward_speed
+from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
@@ -132,19 +133,16 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
 WBC_GRACE_TICKS: int = 5
-# Control ticks from the state an MPC solve starts from to the tick its plan takes over
-# (2 ms): the solve runs in a thread of its own meanwhile, as on the robots, where the MPC
-# and the WBC are separate loops, and the ticks go on following the previous plan.
-# Waited for at that tick, never skipped, so that a ride does not depend on the machine.
-PLAN_LATENCY_TICKS: int = 1
 
 
 class _PendingSolve(NamedTuple):
-    """An MPC solve under way: the started QP, the time of the state it starts from [s],
-    the tick its plan takes over, the time spent building the problem [s], and the
-    solver thread's future (None when solved in the tick)."""
+    """An MPC solve under way: the started QP, the library frame its problem is in, the
+    time of the state it starts from [s], the tick its plan takes over, the time spent
+    building the problem [s], and the solver thread's future (None when solved in the
+    tick)."""
 
     started: StartedSolve
+    frame: PlanarFrame
     time: float
     due: int
     build_s: float
@@ -210,17 +208,20 @@ class MpcRider(Controller):
         board: str,
         settings: MpcSettings | None = None,
         wbc_solver: str = "osqp",
-        plan_latency: int = PLAN_LATENCY_TICKS,
+        plan_latency: int | None = None,
     ) -> None:
         super().__init__(robot, board)
-        if plan_latency < 0 or plan_latency >= MPC_DIVIDER:
-            raise ValueError(
-                f"plan_latency must be 0 to {MPC_DIVIDER - 1} ticks, got {plan_latency}"
-            )
-        self.plan_latency = plan_latency
         from ridempc.boards import load_board
 
         self.pair = load_mpc_pair(robot.name, board)
+        # Ticks from the state a solve starts from to the tick its plan takes over: with 1
+        # or more OSQP iterates in a thread beside the loop and the ticks between follow
+        # the previous plan; waited for at that tick, so that a ride does not depend on the
+        # machine (the pair's ``plan_latency`` unless given).
+        latency = self.pair.plan_latency if plan_latency is None else plan_latency
+        if latency < 0 or latency >= MPC_DIVIDER:
+            raise ValueError(f"plan_latency must be 0 to {MPC_DIVIDER - 1} ticks, got {latency}")
+        self.plan_latency = latency
         loaded = load_board(board)
         n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
         self.platform_feet = platform_feet(robot, n_platforms)
@@ -323,6 +324,7 @@ class MpcRider(Controller):
         self._contacts: tuple[Contact, ...] = ()  # per library contact, the last MPC step
         self._tick = 0
         self._plan: Plan | None = None
+        self._plan_frame = PlanarFrame()
         self._last_problem: MpcProblem | None = None
         self._plan_time = 0.0
         self._command_roll: tuple[float, float] | None = None
@@ -501,8 +503,12 @@ class MpcRider(Controller):
             self.mpc.qp = self.mpc.build_qp(problem)
         self._last_problem = problem
         build = time.perf_counter() - started
-        solve = _PendingSolve(
-            self.mpc.qp.start(problem), now, self._tick + self.plan_latency, build
+        solve = _PendingSolve(  # the frame the plan is in: the map's moves on at the next
+            self.mpc.qp.start(problem),  # tick, the plan only when this one takes over
+            self.map.frame,
+            now,
+            self._tick + self.plan_latency,
+            build,
         )
         if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
             self._adopt(solve, self.mpc.qp.run())
@@ -531,7 +537,7 @@ class MpcRider(Controller):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
         if self.force_filter is not None:
             plan = plan._replace(first_input=self.force_filter(plan.first_input, solve.time))
-        self._plan, self._plan_time = plan, solve.time
+        self._plan, self._plan_time, self._plan_frame = plan, solve.time, solve.frame
         self._set_support(solve.started.problem.contacts[0])
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
@@ -776,7 +782,7 @@ class MpcRider(Controller):
         assert plan is not None
         n = self.layout.names
         x = plan.first_step_state((now - self._plan_time) * 30.0)
-        frame = self.map.frame
+        frame = self._plan_frame
         position = frame.point_to_world(np.array([x[n["com_x"]], x[n["com_y"]], x[n["com_z"]]]))
         velocity = frame.vector_to_world(np.array([x[n["vx"]], x[n["vy"]], x[n["vz"]]]))
         base = self.layout.base_prefix
