@@ -38,12 +38,16 @@ alone, in the ride (so its real-time factor and budget are DAQP's) and in step 3
 WBC comparison, made against OSQP's warm workspace, is then left out. The product's solver
 stays OSQP: this measures the choice in the closed loop.
 
-Times are wall-clock on this machine and vary with its load; the targets are an MPC p99 of
-at most 5 ms and a WBC p99 of at most 1 ms.
+Times are wall-clock on this machine and vary with its load and its speed of the moment,
+which the budget table's **machine reference** records before each pair's ride
+(:func:`reference_ms`, a fixed pure-Python loop: a loop time per tick twice as long on a
+reference twice as long is the same code); the targets are an MPC p99 of at most 5 ms and a
+WBC p99 of at most 1 ms.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -91,8 +95,28 @@ class PairBench:
     wbc_failures: int = 0
     ride_status: str = ""
     budget_ms: dict[str, float] = field(default_factory=dict)
+    reference_ms: float = float("nan")
     solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
     wbc_solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+REFERENCE_ADDITIONS: int = 1_000_000  # the machine reference's loop (reference_ms)
+
+
+def reference_ms(repeats: int = 5) -> float:
+    """The machine's speed at the moment: the best of ``repeats`` timings of a fixed
+    pure-Python loop (``REFERENCE_ADDITIONS`` integer additions) [ms]. The control loop is
+    mostly Python, so its wall time scales with this; benches run at different times compare
+    once each is divided by its reference (on this 2-core machine the same loop ran up to
+    65 % slower from one hour to the next)."""
+    best = math.inf
+    for _ in range(repeats):
+        started = time.perf_counter()
+        total = 0
+        for i in range(REFERENCE_ADDITIONS):
+            total += i
+        best = min(best, time.perf_counter() - started)
+    return 1e3 * best
 
 
 def _stats(values: Sequence[float]) -> tuple[float, float]:
@@ -426,6 +450,7 @@ def bench_pair(
 
     name = f"{robot}-{board}"
     out = PairBench(pair=name, scenario=_scenario_of(name, scenario), wbc_solver=wbc_solver)
+    out.reference_ms = reference_ms()
     result, problems, wbc_inputs, rider, budget = _record(
         robot, board, out.scenario, seconds, wbc_solver
     )
@@ -545,12 +570,15 @@ def bench_table(rows: Sequence[PairBench]) -> str:
 def _budget_table(rows: Sequence[PairBench]) -> list[str]:
     """The closed loop's budget: mean wall time per 2 ms control tick [ms], by part."""
     head = " | ".join(BUDGET_PARTS)
-    lines = ["", f"| pair | mean per control tick [ms]: loop | {head} |"]
-    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS))
+    lines = [
+        "",
+        f"| pair | mean per control tick [ms]: loop | {head} | machine reference [ms] |",
+    ]
+    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS) + "---|")
     for r in rows:
         b = r.budget_ms
         cells = " | ".join(_ms(b.get(k, float("nan"))) for k in ("loop", *BUDGET_PARTS))
-        lines.append(f"| {r.pair} | {cells} |")
+        lines.append(f"| {r.pair} | {cells} | {_ms(r.reference_ms)} |")
     return lines
 
 

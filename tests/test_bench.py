@@ -113,6 +113,12 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     assert all(p > 0.0 for p in parts), out.budget_ms
     assert sum(parts) == pytest.approx(out.budget_ms["loop"], rel=1e-9)
     assert out.budget_ms["loop"] == pytest.approx(2.0 / out.real_time_factor, rel=1e-6)
+    # the machine's speed of the moment, to compare benches made at different times
+    assert 0.0 < out.reference_ms < 1e3  # [ms] a million additions
+    from ridempc.bench import bench_table
+
+    lines = bench_table([out]).splitlines()
+    assert any(line.endswith(f"| {out.reference_ms:.2f} |") for line in lines)
     # the same QPs, to DAQP and proxqp: the same optimum (OSQP polished to its active set)
     assert {"osqp", "daqp"} <= set(out.wbc_solvers)
     for name, figures in out.wbc_solvers.items():
