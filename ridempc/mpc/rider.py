@@ -69,6 +69,7 @@ import math
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
+from functools import cache
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -147,6 +148,14 @@ class _PendingSolve(NamedTuple):
     due: int
     build_s: float
     future: Future[SolveOutcome] | None = None
+
+
+@cache
+def _solver_thread() -> ThreadPoolExecutor:
+    """The thread the MPC's solves run in beside the control loop, one for the process
+    (made at its first use): a rider per ride, and rides one after another (``compare``'s
+    seeds), would otherwise each leave an idle thread behind."""
+    return ThreadPoolExecutor(max_workers=1, thread_name_prefix="mpc")
 
 
 def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
@@ -341,7 +350,6 @@ class MpcRider(Controller):
         self._mpc_ms: list[float] = []
         self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
         self._pending: _PendingSolve | None = None
-        self._worker: ThreadPoolExecutor | None = None
         self._wbc_ms: list[float] = []
         self._diagnostics: dict[str, float] = {}
 
@@ -513,9 +521,8 @@ class MpcRider(Controller):
         if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
             self._adopt(solve, self.mpc.qp.run())
         else:
-            if self._worker is None:
-                self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mpc")
-            self._pending = solve._replace(future=self._worker.submit(self.mpc.qp.run))
+            future = _solver_thread().submit(self.mpc.qp.run)
+            self._pending = solve._replace(future=future)
         self._mpc_main_s += time.perf_counter() - started
 
     def _adopt_pending(self) -> None:
