@@ -41,7 +41,7 @@ def test_a_push_off_weighs_the_speeds_by_the_pairs_tolerances(skate) -> None:
 
 
 def test_push_offs_beyond_the_pairs_largest_target_keep_their_weights() -> None:
-    mpc = LinearMpc.from_library("cyberdog2", "skateboard", "accelerate", 0.7)
+    mpc = LinearMpc.from_library("cyberdog2", "skateboard", "accelerate", 1.0)
     assert mpc.reference.target > mpc.pair.push_max_target
     assert not pushing(mpc.reference, 1.0, mpc.pair.push_max_target)
     np.testing.assert_array_equal(_problem(mpc, 1.0).state_weights, mpc.state_weights)

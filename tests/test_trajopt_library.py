@@ -12,6 +12,10 @@ from ridempc.trajopt.pairs import EntrySpec, load_pair, pair_names
 from ridempc.trajopt.problem import collocation_defect, solve_trajectory
 from ridempc.trajopt.ride_pair import ride_models
 from ridempc.trajopt.ride_problem import ride_layout
+from ridempc.trajopt.rigid_body import feet_world
+from ridempc.trajopt.schedule import Contact
+from ridempc.trajopt.skate_pair import skate_models, skate_options
+from ridempc.trajopt.skate_problem import inward_distances, skate_schedule, triangle_turn
 
 # Largest collocation defect (state units) a committed entry may have: IPOPT's constraint
 # tolerance is 1e-8 on the scaled problem.
@@ -92,3 +96,60 @@ def test_the_rider_keeps_its_riding_height(pair_name: str) -> None:
     for entry in entries:
         sag = float(np.max(np.abs(entry.state("com_z") - height)))
         assert sag < HEIGHT_TOLERANCE, f"{entry.record.name}: {sag:.3f} m off {height:.3f} m"
+
+
+def test_the_dog_keeps_its_centre_of_mass_inside_the_feet_on_the_deck() -> None:
+    """While a foot swings (lift-off and touchdown nodes included) every skateboard entry
+    keeps the centre of mass at least its ``support_margin`` inside the triangle of the three
+    feet on the deck, measured here from the stored states with NumPy (the NLP imposes it in
+    CasADi). Before the margin the entries let it cross the triangle's diagonal about 50 ms
+    before the pushing foot landed, and riders whose trunk tipped a little early fell."""
+    robot, _ = skate_models()
+    nr = 12 + robot.n_joints
+    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
+    for entry in entries:
+        options = skate_options(entry.record.metadata["options"])
+        assert options.support_margin >= 0.01, entry.record.name
+        masks = skate_schedule(robot, entry.record.target, options).contact_masks()
+        swinging = masks[Contact.SWING].any(axis=1)
+        checked = 0
+        for k, x in enumerate(entry.states):
+            around = [j for j in (k - 1, k) if 0 <= j < len(swinging) and swinging[j]]
+            if not around:
+                continue
+            support = np.flatnonzero(masks[Contact.BOARD][around[-1]])
+            assert len(support) == 3
+            feet = feet_world(robot, x[0:3], x[3:6], x[12:nr], np)
+            corners = [feet[i][0:2] for i in support]
+            turn = triangle_turn(np.array(corners))
+            margin = float(np.min(np.asarray(inward_distances(x[0:2], corners, turn))))
+            assert margin >= options.support_margin - 1e-6, (
+                f"{entry.record.name} at {entry.times[k]:.2f} s: {100 * margin:.2f} cm inside"
+            )
+            checked += 1
+        assert checked > 0, entry.record.name
+
+
+def test_the_pushing_foot_lands_nearly_still() -> None:
+    """In the grid step before it lands on the ground the pushing foot of every skateboard
+    entry covers at most ``touchdown_step`` along each horizontal axis (without it, the
+    1.0 m/s entry's foot reached the ground at the trunk's 1.1 m/s)."""
+    robot, _ = skate_models()
+    nr = 12 + robot.n_joints
+    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
+    for entry in entries:
+        options = skate_options(entry.record.metadata["options"])
+        pusher = robot.feet.index(options.pusher)
+        masks = skate_schedule(robot, entry.record.target, options).contact_masks()
+        ground = masks[Contact.GROUND][:, pusher] > 0
+        landings = [k for k in range(1, len(ground)) if ground[k] and not ground[k - 1]]
+        assert landings, entry.record.name
+        for k in landings:
+            before, landed = (
+                feet_world(robot, x[0:3], x[3:6], x[12:nr], np)[pusher]
+                for x in entry.states[k - 1 : k + 1]
+            )
+            step = float(np.max(np.abs(landed[0:2] - before[0:2])))
+            assert step <= options.touchdown_step + 1e-6, (
+                f"{entry.record.name} at {entry.times[k]:.2f} s: {100 * step:.2f} cm"
+            )

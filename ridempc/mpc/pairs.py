@@ -113,7 +113,7 @@ class MpcPair(NamedTuple):
             0.281/0.276/0.332/0.267 to 0.301/0.298/0.318/0.297 m/s and push-off-0.5's from
             0.488/0.480/0.479/0.487 to 0.499/0.504/0.503/0.494; empty elsewhere (no pushes).
         push_max_target: The largest push-off target [m/s] the ``push_tolerances`` apply
-            to: 0.5 on the skateboard (above it the roll phase after the push fell).
+            to: 0.7 on the skateboard (push-off-1.0 falls in its last stroke with them).
         stance_roll: :math:`s` of the deck roll's stance limit
             (:class:`~ridempc.mpc.stance.StanceLimit`), the estimated centre-of-mass
             offset per radian of deck roll [m/rad], or None for no limit: 0.42 on the
@@ -193,7 +193,7 @@ def _skateboard() -> MpcPair:
         roll_observer=0.3,
         swing_force_step=10.0,
         push_tolerances=MappingProxyType({"vx": 0.0125, "board_v": 0.05}),
-        push_max_target=0.5,
+        push_max_target=0.7,
         stance_roll=0.42,
     )
 

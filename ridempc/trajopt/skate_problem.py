@@ -18,11 +18,15 @@ contact schedule's grid (:mod:`.schedule`), Hermite-Simpson within each interval
   cone's inner pyramid, :mod:`ridempc.friction`; :math:`f_n \\ge 0`) on the surface's
   normal, no force on a swinging foot;
 - joint torques of the stance legs, :math:`\\tau = -J_i(q)^\\top R_R^\\top f_i` (the massless
-  leg's statics), within the motor limits (12 N m on CyberDog2); joint angles and speeds
-  within the MJCF's and ``robot.toml``'s limits; board roll within its bottom-out angle;
-  board speed bounded;
+  leg's statics), within ``torque_fraction`` of the motor limits (12 N m on CyberDog2);
+  joint angles and speeds within the MJCF's and ``robot.toml``'s limits; board roll within
+  its bottom-out angle; board speed bounded;
 - swinging feet: clear of the deck (above its top while over it, beside it otherwise) and
   above the ground;
+- support margin: while a foot swings (its lift-off and touchdown nodes included), the
+  centre of mass's ground projection stays at least ``support_margin`` inside the triangle
+  of the three feet on the deck, :math:`d_j(p_{xy}) \\ge m` for its three edges
+  (:func:`inward_distances`);
 - start: the robot in its riding keyframe on a board at rest; end: the board at the target
   speed with the robot riding along (four feet on the deck, no relative motion);
 - cost, eq. (16): state tracking (board speed ramp, deck roll, trunk height, attitude,
@@ -63,10 +67,12 @@ __all__ = [
     "SkateOptions",
     "build_skate_problem",
     "initial_skate_state",
+    "inward_distances",
     "skate_guess",
     "skate_rates",
     "skate_schedule",
     "speed_bound",
+    "triangle_turn",
 ]
 
 Array = NDArray[np.float64]
@@ -90,9 +96,25 @@ class SkateOptions:
         side_margin: Gap between the deck's edge and the pushing foot on the ground [m].
         crouch: How much lower than the keyframe the trunk is asked to ride [m].
         min_board_force: Least normal force of a foot standing on the deck, in units of
-            the weight per foot [-]: keeps the centre of mass inside the three-leg support
+            the weight per foot [-]: keeps the centre of pressure inside the three-leg support
             triangle rather than on its diagonal edge (at 0 the optimum carried the front
             foot opposite the pusher at 6 N, and the MPC rider let it lift off the deck).
+        support_margin: Least horizontal distance of the centre of mass inside the triangle
+            of the three feet on the deck while the fourth swings, from its lift-off node to
+            its touchdown node included [m]. Without it the optimum let the centre of mass
+            cross the triangle's diagonal before the pushing foot landed (it falls towards
+            that foot, which catches it on time in the plan), and a rider whose trunk tipped
+            a little early fell towards the ground with the foot still in the air: 6 of the
+            64 push-offs of seeds 0-15 fell with those libraries, none with these.
+        torque_fraction: Share of the motor torque limits the stance legs' statics may
+            plan [-]. The rest is the whole-body controller's, for the legs' own dynamics
+            (massless here) and its feedback: at 1.0 the 1.0 m/s entry planned the pushing
+            hip at its 12 N m limit, and riders fell short of each push's planned impulse.
+        touchdown_step: Largest horizontal distance [m] the pushing foot may cover, along
+            each axis, in the grid step before it lands on the ground: it lands nearly still
+            (at most ``touchdown_step / dt`` on average over that step, 0.2 m/s) rather
+            than at the trunk's speed (1.1 m/s in the 1.0 m/s entry without it), which the
+            massless legs here do not mind and the simulated leg does.
         speed_margin: Board speed bound as a multiple of the target [-].
         w_speed: Weight of the board speed error [(m/s)^-2 s^-1].
         w_roll: Weight of the deck roll and roll rate.
@@ -120,6 +142,9 @@ class SkateOptions:
     side_margin: float = 0.02
     crouch: float = 0.06
     min_board_force: float = 0.4
+    support_margin: float = 0.015
+    torque_fraction: float = 0.8
+    touchdown_step: float = 0.01
     speed_margin: float = 1.5
     w_speed: float = 10.0
     w_roll: float = 10.0
@@ -216,6 +241,26 @@ def skate_rates(robot: RigidBodyRobot, board: SkateboardModel) -> ca.Function:
     return ca.Function("skate_rates", [x, u, on_deck], [rates])
 
 
+def triangle_turn(vertices: Array) -> float:
+    """+1 if the triangle's vertices (3 x 2) run counter-clockwise, -1 otherwise."""
+    a, b, c = vertices
+    return float(np.sign((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])))
+
+
+def inward_distances(point: Any, vertices: list[Any], turn: float) -> Any:
+    """Signed horizontal distances [m] of ``point`` (x, y) inside each edge of the triangle
+    ``vertices`` (three (x, y)) whose orientation is ``turn`` (:func:`triangle_turn`):
+    :math:`d_j = s\\,((b - a) \\times (p - a)) / \\lVert b - a \\rVert` for the edge
+    :math:`(a, b)`; all three are positive exactly when the point is inside."""
+    rows = []
+    for j in range(3):
+        a, b = vertices[j], vertices[(j + 1) % 3]
+        edge = b - a
+        cross = edge[0] * (point[1] - a[1]) - edge[1] * (point[0] - a[0])
+        rows.append(turn * cross / ca.sqrt(edge[0] ** 2 + edge[1] ** 2))
+    return ca.vertcat(*rows)
+
+
 def _names(robot: RigidBodyRobot) -> tuple[tuple[str, ...], tuple[str, ...]]:
     states = (*_TRUNK, *(f"q_{j}" for j in robot.joints), *BOARD_STATE)
     forces = tuple(f"f_{foot}_{a}" for foot in robot.feet for a in "xyz")
@@ -223,8 +268,10 @@ def _names(robot: RigidBodyRobot) -> tuple[tuple[str, ...], tuple[str, ...]]:
 
 
 def _node_specs(schedule: ContactSchedule, target: float) -> list[NodeSpec]:
-    """Per node: which contact constraints apply (the signature), the node where the pushing
-    foot landed (the reference) and the desired board speed (a ramp to the last push)."""
+    """Per node: which contact constraints apply (the signature: the feet's contacts, the
+    interval's, the feet on the deck while another swings (in the interval before or after
+    the node), last node, first node), the node where the pushing foot landed (the
+    reference) and the desired board speed (a ramp to the last push)."""
     n = schedule.n_intervals
     contact_of = [schedule.phases[i].contacts for i in schedule.phase_of_interval()]
     phase_of = schedule.phase_of_interval()
@@ -233,6 +280,7 @@ def _node_specs(schedule: ContactSchedule, target: float) -> list[NodeSpec]:
     landed = 0
     for k in range(n + 1):
         feet = []
+        reference = None
         for i in range(schedule.n_feet):
             kinds = {
                 c[i]
@@ -253,12 +301,21 @@ def _node_specs(schedule: ContactSchedule, target: float) -> list[NodeSpec]:
                 leaving = (k - first) / schedule.intervals_per_phase[phase_of[k]] <= 0.5
                 surface = phase.swing_from if leaving else phase.swing_to
                 swing = "over" if surface is Contact.BOARD else "beside"
-            feet.append((Contact.BOARD in kinds, ground, swing))
+            descends = (
+                kinds == {Contact.SWING} and k + 1 < n and contact_of[k + 1][i] is Contact.GROUND
+            )
+            if descends:
+                reference = k + 1  # the node where it lands
+            feet.append((Contact.BOARD in kinds, ground, swing, descends))
         interval = contact_of[k] if k < n else None
+        support = None
+        for c in (contact_of[k - 1] if k > 0 else None, interval):
+            if c is not None and Contact.SWING in c:
+                support = tuple(i for i, kind in enumerate(c) if kind is Contact.BOARD)
         # Node 0 (its state fixed by its bounds) and the last node are groups of their own.
-        signature = (tuple(feet), interval, k == n, k == 0)
+        signature = (tuple(feet), interval, support, k == n, k == 0)
         speed = target * min(1.0, schedule.times[k] / ramp_end)
-        specs.append(NodeSpec(signature, landed, (speed,)))
+        specs.append(NodeSpec(signature, landed if reference is None else reference, (speed,)))
     return specs
 
 
@@ -338,7 +395,7 @@ def build_skate_problem(
     def node_terms(
         signature: Any, x: Any, u: Any, u_prev: Any, x_ref: Any, values: Any
     ) -> NodeTerms:
-        feet, interval, last, _ = signature
+        feet, interval, support, last, _ = signature
         terms = NodeTerms()
         xr, xb = x[:nr], x[nr:]
         com, euler, vel, omega, q = xr[0:3], xr[3:6], xr[6:9], xr[9:12], xr[12:nr]
@@ -349,7 +406,7 @@ def build_skate_problem(
         yaw_rate_r = (euler_rate_map(euler[0], euler[1], ca) @ omega)[2]
         # Eq. (14): the robot turns with the board.
         terms.add(ca.sin(xb[4]) * xb[3] + yaw_rate_r / board.reduced.steer_gain, 0.0, 0.0)
-        for i, (on_board, ground, swing) in enumerate(feet):
+        for i, (on_board, ground, swing, descends) in enumerate(feet):
             radius = float(robot.foot_radius[i])
             in_deck = rotation_b.T @ (centres[i] - origin_b)
             beside = board.half_width + radius + o.side_margin
@@ -366,6 +423,13 @@ def build_skate_problem(
                 terms.add(side * in_deck[1], beside, np.inf)
             if swing is not None:
                 terms.add(centres[i][2], radius + o.clearance, np.inf)
+            if descends:  # one step before it lands: nearly above its landing point
+                reach = o.touchdown_step
+                terms.add(centres[i][0:2] - landed[i][0:2], -reach, reach)
+        if support is not None and len(support) == 3:
+            turn = triangle_turn(on_deck_place[list(support), :2])
+            inside = inward_distances(com[0:2], [centres[i][0:2] for i in support], turn)
+            terms.add(inside, o.support_margin, np.inf)
         if last:  # at the target speed, riding along
             board_velocity = ca.vertcat(xb[3] * ca.cos(xb[2]), xb[3] * ca.sin(xb[2]), 0.0)
             terms.add(xb[3] - target, 0.0, 0.0)
@@ -384,7 +448,8 @@ def build_skate_problem(
             terms.add(cone, np.array([least, 0.0, 0.0, 0.0, 0.0]), np.inf)
             leg = list(robot.legs[i])
             torque = jac[i][:, leg].T @ (rotation_r.T @ f)
-            terms.add(torque, -robot.torque_limit[leg], robot.torque_limit[leg])
+            limit = o.torque_fraction * robot.torque_limit[leg]
+            terms.add(torque, -limit, limit)
         # Cost, eq. (16): tracking (a, b), effort (c), effort rate (d).
         board_velocity = ca.vertcat(xb[3] * ca.cos(xb[2]), xb[3] * ca.sin(xb[2]), 0.0)
         com_in_deck = rotation_b.T @ (com - origin_b)
