@@ -158,8 +158,9 @@ def test_a_pair_without_an_mpc_is_refused(tmp_path, capsys) -> None:
 
 def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     """With the ride's command timeline the MPC's deck-roll reference is the command at
-    each node (rate by central differences); without it, the present command extrapolated
-    at its last rate, one MPC step late on a moving command."""
+    each node read the pair's ``roll_lead`` ahead (rate by central differences); without
+    it, the present command extrapolated at its last rate, one MPC step late on a moving
+    command."""
     rider = MpcRider(dog, "skateboard")
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
     scenario = resolve_scenario("roll-tracking", "skateboard")
@@ -168,7 +169,9 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     mpc, names = rider.mpc, rider.layout.names
     problem = mpc.problem(0.0, mpc.reference.sample(0.0, 0, mpc.settings.dt).states[0])
     now = 6.5  # the command crosses zero at its fastest
-    times = now + problem.dt * np.arange(problem.state_reference.shape[0])
+    lead = rider.pair.roll_lead
+    assert lead == pytest.approx(0.08)  # [s] the closed loop's lag on the roll waves
+    times = now + lead + problem.dt * np.arange(problem.state_reference.shape[0])
     wanted = np.array([scenario.command_at(float(t)).roll for t in times])
     assert np.ptp(wanted) > 0.05  # the command moves over the horizon
     roll = rider._roll_horizon(scenario.command_at(now), now)
@@ -190,7 +193,7 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     step = 1.0 / 30.0
     rider._roll_horizon(scenario.command_at(now - step), now - step)
     blind = rider._roll_horizon(scenario.command_at(now), now)
-    assert blind[0] == pytest.approx(wanted[0])
+    assert blind[0] == pytest.approx(wanted[0], abs=1e-3)  # extrapolated over the lead
     assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend
 
 

@@ -714,12 +714,13 @@ class MpcRider(Controller):
         self.estimator.set_support(ground, swinging)
 
     def _roll_horizon(self, command: Command, now: float) -> Array:
-        """The commanded deck roll at the horizon's nodes [rad]: read ahead from the
-        ``command_preview`` when the ride's commands are planned, else the present command
-        extrapolated at its rate (a backward difference over the last MPC step), which
-        tracks a moving command one step late."""
+        """The commanded deck roll at the horizon's nodes [rad], each read the pair's
+        ``roll_lead`` ahead (the closed loop's lag): from the ``command_preview`` when the
+        ride's commands are planned, else the present command extrapolated at its rate (a
+        backward difference over the last MPC step), which tracks a moving command one
+        step late."""
         settings = self.mpc.settings
-        times = now + settings.dt * np.arange(settings.horizon + 1)
+        times = now + self.pair.roll_lead + settings.dt * np.arange(settings.horizon + 1)
         planned = self._planned("roll", times)
         if planned is not None:
             return planned
