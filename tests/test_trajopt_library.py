@@ -3,6 +3,9 @@ and the smallest quadruped entry rebuilt from scratch to the committed trajector
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from typing import Any
+
 import numpy as np
 import pytest
 
@@ -98,19 +101,25 @@ def test_the_rider_keeps_its_riding_height(pair_name: str) -> None:
         assert sag < HEIGHT_TOLERANCE, f"{entry.record.name}: {sag:.3f} m off {height:.3f} m"
 
 
+def _skate_entries() -> Iterator[tuple[Any, Any, dict[Contact, np.ndarray]]]:
+    """Each committed skateboard entry with its stored options and its schedule's masks."""
+    robot, _ = skate_models()
+    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
+    for entry in entries:
+        options = skate_options(entry.record.metadata["options"])
+        yield entry, options, skate_schedule(robot, entry.record.target, options).contact_masks()
+
+
 def test_the_dog_keeps_its_centre_of_mass_inside_the_feet_on_the_deck() -> None:
     """While a foot swings (lift-off and touchdown nodes included) every skateboard entry
     keeps the centre of mass at least its ``support_margin`` inside the triangle of the three
     feet on the deck, measured here from the stored states with NumPy (the NLP imposes it in
-    CasADi). Before the margin the entries let it cross the triangle's diagonal about 50 ms
-    before the pushing foot landed, and riders whose trunk tipped a little early fell."""
+    CasADi). Before the margin the entries left it on the triangle's diagonal when the
+    pushing foot landed, and riders whose trunk tipped a little early fell."""
     robot, _ = skate_models()
     nr = 12 + robot.n_joints
-    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
-    for entry in entries:
-        options = skate_options(entry.record.metadata["options"])
+    for entry, options, masks in _skate_entries():
         assert options.support_margin >= 0.01, entry.record.name
-        masks = skate_schedule(robot, entry.record.target, options).contact_masks()
         swinging = masks[Contact.SWING].any(axis=1)
         checked = 0
         for k, x in enumerate(entry.states):
@@ -136,11 +145,8 @@ def test_the_pushing_foot_lands_nearly_still() -> None:
     1.0 m/s entry's foot reached the ground at the trunk's 1.1 m/s)."""
     robot, _ = skate_models()
     nr = 12 + robot.n_joints
-    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
-    for entry in entries:
-        options = skate_options(entry.record.metadata["options"])
+    for entry, options, masks in _skate_entries():
         pusher = robot.feet.index(options.pusher)
-        masks = skate_schedule(robot, entry.record.target, options).contact_masks()
         ground = masks[Contact.GROUND][:, pusher] > 0
         landings = [k for k in range(1, len(ground)) if ground[k] and not ground[k - 1]]
         assert landings, entry.record.name
