@@ -59,13 +59,17 @@ Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 IntArray = NDArray[np.int64]
 
-# OSQP settings. The QP is scaled here (module docstring), so eps of 1e-4 is 1e-4 of each
-# state's and input's tolerance, and OSQP's own equilibration, which it would redo at every
-# matrix update (0.3 ms), is off. Polishing is off too: on these problems it mostly fails
-# and costs a factorisation. rho = 1.0 took the fewest iterations: on the skateboard's
-# push-off-0.5 and -0.7 rides the p99 fell from 234 and 220 iterations at rho = 0.3 to 73
-# and 123 (OSQP's adaptive rho starts from it and rarely gets there on its own), and
-# Cassie's pairs took the same 30-40 either way.
+# OSQP settings. The QP is scaled here (module docstring), so eps of 1e-3 is 1e-3 of each
+# state's and input's tolerance, far below anything the robot feels, and OSQP's own
+# equilibration, which it would redo at every matrix update (0.3 ms), is off. At 1e-4 the
+# skateboard's recorded push-off-0.5 problems took p99 150 iterations and 190 at most (the
+# return swings after each stroke, which start far from their push weights' tolerances),
+# at 1e-3 60 and 90, and their first inputs moved by at most 0.0044 of their tolerances
+# (0.1 N of force) from a solve to 1e-5. Polishing is off too: on these problems it mostly
+# fails and costs a factorisation. rho = 1.0 took the fewest iterations: on the
+# skateboard's push-off-0.5 and -0.7 rides the p99 fell from 234 and 220 iterations at
+# rho = 0.3 to 73 and 123 (eps 1e-4; OSQP's adaptive rho starts from it and rarely gets
+# there on its own), and Cassie's pairs took the same 30-40 either way.
 # The budget is an iteration count, not a wall-clock time limit, so that a ride does not
 # depend on the machine's load: warm-started solves take 30-40 iterations (p90) at about
 # 0.05 ms each, and 400 iterations (about 20 ms) leave a third of the 33 ms period to the
@@ -73,8 +77,8 @@ IntArray = NDArray[np.int64]
 # hardware); a solve beyond it then falls back too.
 DEFAULT_SETTINGS: dict[str, Any] = {
     "verbose": False,
-    "eps_abs": 1e-4,
-    "eps_rel": 1e-4,
+    "eps_abs": 1e-3,
+    "eps_rel": 1e-3,
     "max_iter": 400,
     "rho": 1.0,
     "scaling": 0,
