@@ -23,6 +23,15 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    median and p99 of the update-and-solve time [ms].
 3. **WBC.** The recorded ticks are solved again by a fresh
    :class:`~ridempc.wbc.WholeBodyController`: median and p99 of model update + QP [ms].
+
+   Steps 2 and 3 run :data:`PASSES` times, each from a fresh QP or WBC, so each pass does
+   the same work (the same warm starts, the same iterations). The median and p99 are the
+   first pass's wall times, as a controller would see them; the **best p99** is the p99 of
+   each problem's fastest pass, the work itself without the machine's interruptions. On
+   this 2-core virtual machine those are what makes the tail: the Hovershoes' whole-body
+   ticks took 0.63 ms median in each of three passes and p99 1.07, 0.80 and 1.14 ms, but
+   the slowest 30 ticks of one pass were not those of the next (one in common), and each
+   tick's fastest pass gave a p99 of 0.69 ms.
 4. **Other solvers.** The same WBC QPs (dense, a tick each) go to DAQP (the WBC's own
    second solver) and to proxqp through qpsolvers, timed per call from a cold start
    against OSQP's update-and-solve in its warm workspace, objectives compared with OSQP's.
@@ -72,6 +81,7 @@ BENCH_SCENARIOS: dict[str, str] = {
     "cassie-hovershoes": "velocity-steps",
 }
 DEFAULT_SECONDS: float = 6.0
+PASSES: int = 3  # the recorded problems are solved this many times (module docstring)
 
 
 @dataclass
@@ -91,6 +101,8 @@ class PairBench:
     mpc_tick_p99_ms: float = float("nan")
     wbc_solve_median_ms: float = float("nan")
     wbc_solve_p99_ms: float = float("nan")
+    mpc_solve_best_p99_ms: float = float("nan")
+    wbc_solve_best_p99_ms: float = float("nan")
     wbc_failures: int = 0
     ride_status: str = ""
     budget_ms: dict[str, float] = field(default_factory=dict)
@@ -447,7 +459,6 @@ def bench_pair(
     """Record one pair's ride and time its problems (see the module docstring), with
     ``wbc_solver`` solving the whole-body QPs in the ride and in their timing."""
     from ridempc.mpc.controller import LinearMpc
-    from ridempc.wbc import WholeBodyController
 
     name = f"{robot}-{board}"
     out = PairBench(pair=name, scenario=_scenario_of(name, scenario), wbc_solver=wbc_solver)
@@ -464,39 +475,58 @@ def bench_pair(
     out.mpc_tick_median_ms, out.mpc_tick_p99_ms = _stats([1e-3 * ms for ms in rider.mpc_tick_ms])
     if problems:
         mpc = LinearMpc(rider.pair, rider.mpc.reference, rider.mpc.model, rider.mpc.settings)
-        qp = mpc.build_qp(problems[0])
-        times = []
-        with frozen_heap():  # the recorded problems are not the controller's to collect
-            for problem in problems:
-                started = time.perf_counter()
-                qp.solve(problem)
-                times.append(time.perf_counter() - started)
-        out.mpc_solve_median_ms, out.mpc_solve_p99_ms = _stats(times)
+        passes = []
+        for _ in range(PASSES):  # each pass a fresh QP: the same warm starts, the same work
+            qp = mpc.build_qp(problems[0])
+            times = []
+            with frozen_heap():  # the recorded problems are not the controller's to collect
+                for problem in problems:
+                    started = time.perf_counter()
+                    qp.solve(problem)
+                    times.append(time.perf_counter() - started)
+            passes.append(times)
+        out.mpc_solve_median_ms, out.mpc_solve_p99_ms = _stats(passes[0])
+        out.mpc_solve_best_p99_ms = _stats(np.min(passes, axis=0).tolist())[1]
         out.solvers = _other_solvers(qp, problems)
-        out.solvers["osqp"] = {**_figures(times, [0.0], int(qp.failures)), "warm_started": True}
+        out.solvers["osqp"] = {
+            **_figures(passes[0], [0.0], int(qp.failures)),
+            "warm_started": True,
+        }
     if wbc_inputs:
-        wbc = WholeBodyController(  # the rider's own: its settings, its rolling platforms
-            rider.robot,
-            rider.wbc.settings,
-            pinocchio=rider.pinocchio,
-            platforms=rider.wbc.platforms,
-        )
-        times, solved = [], []
-        with frozen_heap():
-            for state, targets in wbc_inputs:
-                started = time.perf_counter()
-                try:
-                    output = wbc.solve(state, targets)
-                except RidempcError:  # a tick of a ride that was falling: timed, counted
-                    out.wbc_failures += 1
-                else:
-                    assert wbc.last_problem is not None and wbc.last_solution is not None
-                    solved.append((wbc.last_problem, wbc.last_solution.x, 1e-3 * output.solve_ms))
-                times.append(time.perf_counter() - started)
+        times, solved, out.wbc_failures = _wbc_pass(rider, wbc_inputs)
+        passes = [times] + [_wbc_pass(rider, wbc_inputs)[0] for _ in range(PASSES - 1)]
         out.wbc_solve_median_ms, out.wbc_solve_p99_ms = _stats(times)
+        out.wbc_solve_best_p99_ms = _stats(np.min(passes, axis=0).tolist())[1]
         # the comparison is against OSQP's warm workspace: with DAQP in the loop, none
         out.wbc_solvers = _other_wbc_solvers(solved) if wbc_solver == "osqp" else {}
     return out
+
+
+def _wbc_pass(rider: Any, inputs: list) -> tuple[list[float], list, int]:
+    """The recorded whole-body ticks solved in order by a fresh copy of the rider's WBC:
+    each tick's wall time [s], the solved QPs (problem, solution, OSQP's time [s]) and the
+    number of ticks that failed."""
+    from ridempc.wbc import WholeBodyController
+
+    wbc = WholeBodyController(  # the rider's own: its settings, its rolling platforms
+        rider.robot,
+        rider.wbc.settings,
+        pinocchio=rider.pinocchio,
+        platforms=rider.wbc.platforms,
+    )
+    times, solved, failures = [], [], 0
+    with frozen_heap():
+        for state, targets in inputs:
+            started = time.perf_counter()
+            try:
+                output = wbc.solve(state, targets)
+            except RidempcError:  # a tick of a ride that was falling: timed, counted
+                failures += 1
+            else:
+                assert wbc.last_problem is not None and wbc.last_solution is not None
+                solved.append((wbc.last_problem, wbc.last_solution.x, 1e-3 * output.solve_ms))
+            times.append(time.perf_counter() - started)
+    return times, solved, failures
 
 
 def _other_wbc_solvers(solved: list) -> dict[str, dict[str, Any]]:
@@ -548,18 +578,20 @@ def bench_table(rows: Sequence[PairBench]) -> str:
     """The results as a Markdown table, then one table each of the MPC and WBC QP solvers."""
 
     lines = [
-        "| pair | scenario | ride | MPC problems | MPC QP median / p99 [ms] | "
+        "| pair | scenario | ride | MPC problems | MPC QP median / p99 / best p99 [ms] | "
         "MPC tick in the ride median / p99 [ms] | WBC ticks (failed) | "
-        "WBC (solver) median / p99 [ms] | real-time factor |",
+        "WBC (solver) median / p99 / best p99 [ms] | real-time factor |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
+        mpc = (r.mpc_solve_median_ms, r.mpc_solve_p99_ms, r.mpc_solve_best_p99_ms)
+        wbc = (r.wbc_solve_median_ms, r.wbc_solve_p99_ms, r.wbc_solve_best_p99_ms)
         lines.append(
             f"| {r.pair} | {r.scenario} | {r.ride_status} ({r.simulated_s:.2f} s) | "
-            f"{r.mpc_problems} | {_ms(r.mpc_solve_median_ms)} / {_ms(r.mpc_solve_p99_ms)} | "
+            f"{r.mpc_problems} | {' / '.join(map(_ms, mpc))} | "
             f"{_ms(r.mpc_tick_median_ms)} / {_ms(r.mpc_tick_p99_ms)} | "
             f"{r.wbc_ticks} ({r.wbc_failures}) | "
-            f"({r.wbc_solver}) {_ms(r.wbc_solve_median_ms)} / {_ms(r.wbc_solve_p99_ms)} | "
+            f"({r.wbc_solver}) {' / '.join(map(_ms, wbc))} | "
             f"{_ms(r.real_time_factor)} |"
         )
     lines += _budget_table(rows)

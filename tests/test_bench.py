@@ -106,6 +106,9 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     out = bench_pair("cassie", "segway", seconds=0.2)
     assert out.ride_status == "ok" and out.wbc_ticks == 100
     assert out.wbc_failures == 0
+    # each problem's fastest pass: never slower than the first pass, at the p99 as well
+    assert 0.0 < out.wbc_solve_best_p99_ms <= out.wbc_solve_p99_ms
+    assert 0.0 < out.mpc_solve_best_p99_ms <= out.mpc_solve_p99_ms
     # the closed loop's budget: its parts add up to the loop's wall time per tick
     from ridempc.bench import BUDGET_PARTS
 
