@@ -333,8 +333,10 @@ def test_reference_schedule_and_steady_riding(skate_mpc: LinearMpc) -> None:
     # Parameters (the deck flags) agree with the schedule.
     on_deck = np.array([[c is Contact.BOARD for c in cs] for cs in reference.schedule])
     np.testing.assert_array_equal(on_deck, reference.parameters > 0.5)
-    # After the end: the board rolls on at its final speed, the rest is held.
-    window = reference.sample(reference.duration + 1.0, 3, MPC_STEP)
+    # After the end: the board rolls on at its final speed, the rest is held once the dog
+    # has settled over its feet (test_settle).
+    assert reference.settle_inputs is not None
+    window = reference.sample(reference.duration + reference.settle_time + 1.0, 3, MPC_STEP)
     names = reference.state_names
     x = window.states[:, names.index("board_x")]
     speed = reference.states[-1, names.index("board_v")]
@@ -342,7 +344,8 @@ def test_reference_schedule_and_steady_riding(skate_mpc: LinearMpc) -> None:
     np.testing.assert_allclose(
         window.states[:, names.index("com_z")], reference.states[-1, 2], atol=1e-3
     )
-    np.testing.assert_allclose(window.inputs, np.tile(reference.inputs[-1], (3, 1)))
+    settled = reference.inputs[-1] + reference.settle_inputs
+    np.testing.assert_allclose(window.inputs, np.tile(settled, (3, 1)))
     # The 500 Hz tick's states alone are the window's, before, during and after the entry.
     for t in (-1.0, 0.4 * reference.duration, reference.duration + 1.0):
         times = t + MPC_STEP * np.arange(4)

@@ -359,6 +359,24 @@ def test_push_off_1_0_seed_5_rides_its_roll_wave_within_the_stance_limit(dog) ->
     assert low < -0.1 and high > 0.1  # a normal stance holds the whole wave
     metrics = run_metrics(result, scenario, dog)
     assert metrics["roll_rmse"] < 0.02
+    # settled over its four feet after the push-off (:mod:`ridempc.mpc.settle`): 1.2 cm
+    # ahead of their centre at 10.5 s, where the library's last node held it 8-10 cm ahead
+    assert abs(_com_ahead_of_feet(scene, result.log, dog)) < 0.03
+
+
+def _com_ahead_of_feet(scene, log, robot) -> float:
+    """How far the robot's centre of mass stands ahead of its contact sites' centre along
+    the deck at the log's last sample [m] (MuJoCo's, from the logged configuration)."""
+    data = mujoco.MjData(scene.model)
+    qpos = log["qpos"][-1]
+    data.qpos[: qpos.size] = qpos
+    mujoco.mj_kinematics(scene.model, data)
+    mujoco.mj_comPos(scene.model, data)
+    root = scene.model.body(robot.params.base_body).id
+    feet = np.mean([data.site(name).xpos for name in robot.params.contact_sites], axis=0)
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, log["board_quaternion"][-1, 0])
+    return float((rotation.reshape(3, 3).T @ (data.subtree_com[root] - feet))[0])
 
 
 def test_the_cassie_riders_read_a_planned_speed_over_their_horizon(dog) -> None:

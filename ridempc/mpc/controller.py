@@ -21,6 +21,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
@@ -74,6 +75,13 @@ class MpcSettings:
             raise ConfigError(
                 f"MPC terminal factor must be non-negative, got {self.terminal_factor}"
             )
+
+
+def _riding(pair: MpcPair, reference: MotionReference, rates: ca.Function) -> MotionReference:
+    """``reference`` ridden on after its end (:func:`~ridempc.mpc.reference.steady_riding`),
+    settling as the pair says (``MpcPair.settle``)."""
+    steady = steady_riding(reference, rates)
+    return steady if pair.settle is None else pair.settle(steady)
 
 
 def _tolerance(weights: Array) -> Array:
@@ -184,7 +192,7 @@ class LinearMpc:
         pair = load_mpc_pair(robot, board)
         reference = select_reference(robot, board, kind, target, folder=folder)
         rates = pair.pair.rates(reference.metadata)
-        return cls(pair, steady_riding(reference, rates), build_linear_model(rates), settings)
+        return cls(pair, _riding(pair, reference, rates), build_linear_model(rates), settings)
 
     def retarget(self, kind: str, target: float, folder: Path | None = None) -> None:
         """Track another library trajectory of the same pair, keeping the Jacobians and the
@@ -200,7 +208,7 @@ class LinearMpc:
                 f"reference '{reference.name}' has contacts {reference.contact_names}, "
                 f"expected {self.reference.contact_names}"
             )
-        self.reference = steady_riding(reference, self.model.rates)
+        self.reference = _riding(self.pair, reference, self.model.rates)
 
     def problem(self, t: float, x0: Array, drift: Array | None = None) -> MpcProblem:
         """The MPC problem at time ``t`` [s] (since the reference's start) from ``x0``,

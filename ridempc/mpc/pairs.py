@@ -24,6 +24,8 @@ from numpy.typing import NDArray
 from ridempc.boards import load_board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.errors import UnknownNameError
+from ridempc.mpc.reference import MotionReference
+from ridempc.mpc.settle import settle_over_feet
 from ridempc.trajopt.pairs import Pair, load_pair
 from ridempc.trajopt.ride_pair import ride_models
 from ridempc.trajopt.ride_problem import ride_layout
@@ -34,6 +36,7 @@ from ridempc.trajopt.skateboard import BOARD_STATE, deck_frame
 __all__ = ["MPC_PAIRS", "MpcPair", "load_mpc_pair", "surface_rotations"]
 
 Array = NDArray[np.float64]
+SETTLE_TIME: float = 1.5  # [s] the skateboard's settle over its feet after a push-off
 
 
 class MpcPair(NamedTuple):
@@ -154,6 +157,13 @@ class MpcPair(NamedTuple):
             ms after the push-offs), which took roll-tracking seed 0's roll RMSE from
             0.0146 to 0.0091 rad at 0.066 s and 0.0097 at 0.1 s, and push-off-0.5 seed
             14's from 0.0200 to 0.0127 and 0.0101; 0 elsewhere (no deck roll).
+        settle: What the reference does after its end besides riding on
+            (:mod:`~ridempc.mpc.settle`), or None for nothing: on the skateboard the dog
+            settles back over its four feet in 1.5 s (``settle_over_feet``), where held at
+            the library's last node it balanced on with 80-97 % of its weight on its front
+            feet. Push-off-1.0, seeds 0-31: seed 25 fell at 15.05 s held and rides settled
+            (seed 18 falls either way, in its last stroke, before the settle); None
+            elsewhere.
     """
 
     pair: Pair
@@ -175,6 +185,7 @@ class MpcPair(NamedTuple):
     speed_preview: bool = False
     plan_latency: int = 0
     roll_lead: float = 0.0
+    settle: Callable[[MotionReference], MotionReference] | None = None
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -206,6 +217,7 @@ def _skateboard() -> MpcPair:
         push_max_target=0.7,
         stance_roll=0.42,
         roll_lead=0.08,
+        settle=partial(settle_over_feet, robot=robot, duration=SETTLE_TIME),
     )
 
 

@@ -14,7 +14,8 @@ inputs averaged over each MPC step (the library holds them over its own interval
 parameters and contacts of the interval each step starts in. After the end the rider rides
 on steadily (:func:`steady_riding`, from the pair's dynamics): every state whose rate does
 not depend on the inputs (positions, headings, angles) advances at its rate at the last
-node, the others are held at the last node.
+node, the others are held at the last node; a pair may have it settle into another
+posture meanwhile (:mod:`ridempc.mpc.settle`).
 
 The contact schedule comes from the entry: the forces are the inputs named
 ``f_<contact>_x|y|z``, and each phase of the entry's ``metadata.phases`` names where each
@@ -92,6 +93,10 @@ class MotionReference:
         friction: The library's friction coefficient :math:`\\mu` [-].
         steady_rates: Rates at which states advance after the end (zero: held; see
             :func:`steady_riding`).
+        settle_states: Offset the states reach ``settle_time`` after the end (None:
+            none; :mod:`ridempc.mpc.settle`).
+        settle_inputs: Offset the inputs reach then (None: none).
+        settle_time: How long the offsets take to grow in [s].
         metadata: The entry's metadata (the lower one's for a blend), from which the
             pair rebuilds its ``rates``.
     """
@@ -112,6 +117,9 @@ class MotionReference:
     friction: float
     steady_rates: Array
     metadata: dict[str, Any]
+    settle_states: Array | None = None
+    settle_inputs: Array | None = None
+    settle_time: float = 0.0
 
     @cached_property
     def _input_integral(self) -> Array:
@@ -155,6 +163,8 @@ class MotionReference:
         inputs = np.diff(running, axis=0) / dt
         before = times[:-1] < self.times[0]
         inputs[before] = self.inputs[0]
+        if self.settle_inputs is not None:
+            inputs += self._settled(times[:-1])[:, None] * self.settle_inputs
         interval = np.clip(
             np.floor((times[:-1] - self.times[0]) / step + 1e-9).astype(int),
             0,
@@ -175,7 +185,15 @@ class MotionReference:
         times = np.asarray(times, dtype=np.float64)
         states = _interp_rows(times, self.times, self.states)
         states += np.maximum(times - self.times[-1], 0.0)[:, None] * self.steady_rates
+        if self.settle_states is not None:
+            states += self._settled(times)[:, None] * self.settle_states
         return states
+
+    def _settled(self, times: Array) -> Array:
+        """How far the settle has gone at ``times``: :math:`3\\tau^2 - 2\\tau^3`,
+        :math:`\\tau = (t - T) / t_{settle}` clipped to [0, 1]."""
+        tau = np.clip((times - self.times[-1]) / max(self.settle_time, 1e-9), 0.0, 1.0)
+        return tau * tau * (3.0 - 2.0 * tau)
 
 
 def _interp_rows(t: Array, grid: Array, table: Array) -> Array:

@@ -1,0 +1,103 @@
+"""After a push-off: the reference settles the rider back over its four feet.
+
+The skateboard library's entries end with the centre of mass 7-9.5 cm ahead of where it
+stood at the start, over the four feet (nothing in the trajectory optimisation's cost keeps
+it back: 0.3-1.0 m/s), and a reference held at its last node (:func:`~ridempc.mpc.reference.
+steady_riding`) keeps the rider there for the rest of the ride, with 80-97 % of its weight on
+its front feet: on push-off-1.0, seed 25, a rear foot carrying 0-3 N drifted off the rolling
+deck at 14.7 s and the ride fell.
+
+:func:`settle_over_feet` gives the reference an offset that grows after its end, over
+``duration`` [s], by a smoothstep :math:`s(\\tau) = 3\\tau^2 - 2\\tau^3`,
+:math:`\\tau = (t - T)/\\text{duration}` clipped to [0, 1]
+(:meth:`~ridempc.mpc.reference.MotionReference.states_at`):
+
+- the centre of mass moves along the deck, in the board's axes, back to where it stood at
+  the start, :math:`\\Delta c_{xy} = R_z(\\psi_T)\\,(r_0 - r_T)` [m] with
+  :math:`r = R_z(-\\psi)(c_{xy} - b_{xy})` its place on the board (heading :math:`\\psi`,
+  origin :math:`b`); its height and the trunk's attitude stay the end's (the riding
+  crouch);
+- the joint angles follow, :math:`\\Delta q` [rad] such that every foot stays where it
+  stood at the end, :math:`p_i(c_T + \\Delta c, \\theta_T, q_T + \\Delta q) = p_i(c_T,
+  \\theta_T, q_T)` (:func:`~ridempc.trajopt.rigid_body.feet_world`, solved by
+  least squares);
+- the deck forces share the weight as at the start: the first interval's forces, turned
+  to the final heading, in place of the last's, :math:`\\Delta f_i = R_z(\\psi_T -
+  \\psi_0) f_{i,0} - f_{i,T}` [N].
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from ridempc.errors import ConfigError
+from ridempc.mpc.reference import MotionReference
+from ridempc.trajopt.rigid_body import RigidBodyRobot, feet_world
+
+__all__ = ["settle_over_feet"]
+
+Array = NDArray[np.float64]
+_BOARD = ("com_x", "com_y", "board_x", "board_y", "board_yaw")
+
+
+def _turn(angle: float) -> Array:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def settle_over_feet(
+    reference: MotionReference, robot: RigidBodyRobot, duration: float
+) -> MotionReference:
+    """``reference`` settling back over the feet after its end (module docstring).
+
+    Args:
+        reference: A reference on one board (states ``com_*``, ``trunk_*``, ``q_*`` and
+            ``board_x``, ``board_y``, ``board_yaw``).
+        robot: The SRBKM robot of its states.
+        duration: Time the settle takes after the end [s].
+
+    Raises:
+        ConfigError: The reference has no single board, or its joints do not fit the robot.
+    """
+    names = reference.state_names
+    joints = [k for k, n in enumerate(names) if n.startswith("q_")]
+    layout = names[:3] == ("com_x", "com_y", "com_z") and names[3].endswith("_roll")
+    if not (layout and set(_BOARD) <= set(names)) or len(joints) != robot.n_joints:
+        raise ConfigError(
+            f"reference '{reference.name}': no single board and {robot.n_joints} joints "
+            "to settle on"
+        )
+    i = names.index
+    first, last = reference.states[0], reference.states[-1]
+
+    def on_board(x: Array) -> Array:
+        offset = np.array([x[i("com_x")] - x[i("board_x")], x[i("com_y")] - x[i("board_y")]])
+        return _turn(-x[i("board_yaw")]) @ offset
+
+    heading = float(last[i("board_yaw")])
+    shift = np.zeros(3)
+    shift[:2] = _turn(heading) @ (on_board(first) - on_board(last))
+    com, euler = last[0:3], last[3:6]  # eq. (1)'s layout: CoM, then roll, pitch, yaw
+    q_end = last[joints]
+    feet = np.concatenate(feet_world(robot, com, euler, q_end, np))
+
+    def gap(q: Array) -> Array:
+        return np.concatenate(feet_world(robot, com + shift, euler, q, np)) - feet
+
+    solved = least_squares(gap, q_end, bounds=(robot.q_lower, robot.q_upper), xtol=1e-12)
+    states = np.zeros(len(names))
+    states[[i("com_x"), i("com_y")]] = shift[:2]
+    states[joints] = solved.x - q_end
+    inputs = np.zeros(reference.inputs.shape[1])
+    turn = _turn(heading - float(first[i("board_yaw")]))
+    for rows in reference.force_index:
+        start = reference.inputs[0, rows].copy()
+        start[:2] = turn @ start[:2]
+        inputs[rows] = start - reference.inputs[-1, rows]
+    return replace(
+        reference, settle_states=states, settle_inputs=inputs, settle_time=float(duration)
+    )
