@@ -84,3 +84,16 @@ def test_a_reference_without_one_board_cannot_settle() -> None:
     robot, _ = skate_models()
     with pytest.raises(ConfigError, match="settle"):
         settle_over_feet(shoes, robot, 1.0)
+
+
+def test_a_settle_the_legs_cannot_reach_is_refused(settled) -> None:
+    """A reference whose start stood a metre further back on the board: no joint angles
+    keep the feet where they ended, and the error says so in one line."""
+    reference, _ = settled
+    robot, _ = skate_models()
+    states = reference.states.copy()
+    states[0, reference.state_names.index("com_x")] -= 1.0
+    far = replace(reference, states=states, settle_states=None, settle_inputs=None)
+    with pytest.raises(ConfigError, match="no joint angles keep the feet in place") as info:
+        settle_over_feet(far, robot, 1.0)
+    assert "\n" not in str(info.value)
