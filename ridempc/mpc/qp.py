@@ -69,7 +69,12 @@ IntArray = NDArray[np.int64]
 # fails and costs a factorisation. rho = 1.0 took the fewest iterations: on the
 # skateboard's push-off-0.5 and -0.7 rides the p99 fell from 234 and 220 iterations at
 # rho = 0.3 to 73 and 123 (eps 1e-4; OSQP's adaptive rho starts from it and rarely gets
-# there on its own), and Cassie's pairs took the same 30-40 either way.
+# there on its own), and Cassie's pairs took the same 30-40 either way. OSQP adapts rho when
+# its estimate is 2 times off (``adaptive_rho_tolerance``; its default 5): on the skateboard's
+# 16 s push-off-0.7 rides the slowest solves, a run of 150-170 iterations in the last
+# stroke's return swing, took the QP's p99 from 6.23 to 4.34 ms (seed 2) and 4.84 to 4.10
+# ms (seed 1), their first inputs within 0.032 of their tolerances; push-off-0.5's and
+# Cassie's pairs' problems came out the same to the bit (their rho never moved either way).
 # The budget is an iteration count, not a wall-clock time limit, so that a ride does not
 # depend on the machine's load: warm-started solves take 30-40 iterations (p90) at about
 # 0.05 ms each, and 400 iterations (about 20 ms) leave a third of the 33 ms period to the
@@ -83,6 +88,7 @@ DEFAULT_SETTINGS: dict[str, Any] = {
     "rho": 1.0,
     "scaling": 0,
     "check_termination": 10,
+    "adaptive_rho_tolerance": 2.0,
     "polishing": False,
     "warm_starting": True,
 }
