@@ -37,6 +37,7 @@ from scipy.optimize import least_squares
 from ridempc.errors import ConfigError
 from ridempc.mpc.reference import MotionReference
 from ridempc.trajopt.rigid_body import RigidBodyRobot, feet_world
+from ridempc.trajopt.rotations import rotation_z
 
 __all__ = ["FOOT_TOLERANCE", "settle_over_feet"]
 
@@ -46,11 +47,6 @@ FOOT_TOLERANCE: float = 1e-6  # [m] how far the settled joints may leave a foot
 # Solved offsets by reference (its name, first and last nodes, forces, settle time): the
 # least squares take 7-10 ms, and the rider retargets inside an MPC tick.
 _SOLVED: dict[tuple[object, ...], tuple[Array, Array]] = {}
-
-
-def _turn(angle: float) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s], [s, c]])
 
 
 def settle_over_feet(
@@ -107,12 +103,11 @@ def _offsets(reference: MotionReference, robot: RigidBodyRobot) -> tuple[Array, 
     first, last = reference.states[0], reference.states[-1]
 
     def on_board(x: Array) -> Array:
-        offset = np.array([x[i("com_x")] - x[i("board_x")], x[i("com_y")] - x[i("board_y")]])
-        return _turn(-x[i("board_yaw")]) @ offset
+        offset = [x[i("com_x")] - x[i("board_x")], x[i("com_y")] - x[i("board_y")], 0.0]
+        return np.asarray(rotation_z(-x[i("board_yaw")]) @ offset)
 
     heading = float(last[i("board_yaw")])
-    shift = np.zeros(3)
-    shift[:2] = _turn(heading) @ (on_board(first) - on_board(last))
+    shift = rotation_z(heading) @ (on_board(first) - on_board(last))
     com, euler = last[0:3], last[3:6]  # eq. (1)'s layout: CoM, then roll, pitch, yaw
     q_end = last[joints]
     feet = np.concatenate(feet_world(robot, com, euler, q_end, np))
@@ -132,9 +127,7 @@ def _offsets(reference: MotionReference, robot: RigidBodyRobot) -> tuple[Array, 
     states[[i("com_x"), i("com_y")]] = shift[:2]
     states[joints] = solved.x - q_end
     inputs = np.zeros(reference.inputs.shape[1])
-    turn = _turn(heading - float(first[i("board_yaw")]))
+    turn = rotation_z(heading - float(first[i("board_yaw")]))
     for rows in reference.force_index:
-        start = reference.inputs[0, rows].copy()
-        start[:2] = turn @ start[:2]
-        inputs[rows] = start - reference.inputs[-1, rows]
+        inputs[rows] = turn @ reference.inputs[0, rows] - reference.inputs[-1, rows]
     return states, inputs
