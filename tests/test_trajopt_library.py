@@ -15,7 +15,7 @@ from ridempc.trajopt.pairs import EntrySpec, load_pair, pair_names
 from ridempc.trajopt.problem import collocation_defect, solve_trajectory
 from ridempc.trajopt.ride_pair import ride_models
 from ridempc.trajopt.ride_problem import ride_layout
-from ridempc.trajopt.rigid_body import feet_world
+from ridempc.trajopt.rigid_body import GRAVITY, feet_world
 from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skate_pair import skate_models, skate_options
 from ridempc.trajopt.skate_problem import inward_distances, skate_schedule, triangle_turn
@@ -158,4 +158,23 @@ def test_the_pushing_foot_lands_nearly_still() -> None:
             step = float(np.max(np.abs(landed[0:2] - before[0:2])))
             assert step <= options.touchdown_step + 1e-6, (
                 f"{entry.record.name} at {entry.times[k]:.2f} s: {100 * step:.2f} cm"
+            )
+
+
+def test_the_pushing_foot_lifts_unloaded() -> None:
+    """In the grid step before it lifts off the ground the pushing foot of every skateboard
+    entry carries at most ``liftoff_force`` weights per foot (without it, the 1.0 m/s entry's
+    last push ended at 51 N, and push-off-1.0 seed 18 fell after it)."""
+    robot, _ = skate_models()
+    weight_per_foot = robot.mass * GRAVITY / robot.n_feet
+    for entry, options, masks in _skate_entries():
+        pusher = robot.feet.index(options.pusher)
+        ground = masks[Contact.GROUND][:, pusher] > 0
+        lifts = [k for k in range(len(ground) - 1) if ground[k] and not ground[k + 1]]
+        assert lifts, entry.record.name
+        normal = entry.input_names.index(f"f_{options.pusher}_z")
+        for k in lifts:
+            force = float(entry.inputs[k, normal])
+            assert force <= options.liftoff_force * weight_per_foot + 1e-6, (
+                f"{entry.record.name} at {entry.times[k]:.2f} s: {force:.1f} N"
             )

@@ -162,7 +162,8 @@ class MpcPair(NamedTuple):
             settles back over its four feet in 1.5 s (``settle_over_feet``), where held at
             the library's last node it balanced on with 80-97 % of its weight on its front
             feet. Push-off-1.0, seeds 0-31: seed 25 fell at 15.05 s held and rides settled
-            (seed 18 falls either way, in its last stroke, before the settle); None
+            (seed 18 fell either way, in its last stroke, before the settle, until the
+            library's pushes lifted the foot unloaded, ``SkateOptions.liftoff_force``); None
             elsewhere.
     """
 
