@@ -72,6 +72,10 @@ def ride(request: RideRequest) -> dict[str, Any]:
         ConfigError: A malformed scenario or parameter file, or a scenario that does not
             apply to the robot-board pair.
     """
+    if request.video:
+        from ridempc.sim.video import require_video_writer
+
+        require_video_writer()
     robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
     board = load_board(request.board)
     board_name = board.name if board is not None else NO_BOARD

@@ -43,3 +43,21 @@ def test_negative_snapshot_count_is_refused(tmp_path, capsys) -> None:
     assert main(["sim", "--snapshots", "-1", "--out", str(out)]) == 2
     assert "--snapshots -1" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_video_without_its_extra_is_refused_before_the_ride(tmp_path, capsys, monkeypatch) -> None:
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "imageio_ffmpeg" else real(name, *a),
+    )
+    out = tmp_path / "video"
+    code = main(["sim", "--robot", "cyberdog2", "--duration", "0.5", "--video", "--out", str(out)])
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "'video' extra" in err and "pip install" in err
+    assert not out.exists()
