@@ -350,7 +350,7 @@ def _joint_damping(changes: ScheduledChanges, change: ParameterChange) -> Action
             change, f"joint '{change.joint}' is not a robot joint (valid: {', '.join(joints)})"
         )
     chosen = [joints[change.joint]] if change.joint is not None else list(joints.values())
-    dofs = [int(model.jnt_dofadr[j]) for j in chosen]
+    dofs = [d for d in range(model.nv) if model.dof_jntid[d] in chosen]  # a ball has 3
     knob = KNOBS[change.parameter]
     values = [changes.target(change, changes.nominal["dof_damping"][d], knob) for d in dofs]
 
