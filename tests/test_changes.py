@@ -24,8 +24,8 @@ from ridempc.errors import ConfigError
 from ridempc.robots import load_robot
 from ridempc.scenarios import load_scenario_file
 from ridempc.scenarios.scenario import CommandEvent, ParameterChange, Scenario
-from ridempc.sim.changes import KNOBS, SCALE_MAX
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.knobs import KNOBS, SCALE_MAX
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.scene import BOARD_PREFIX, Scene, build_scene
 from ridempc.sim.simulation import Simulation

@@ -37,7 +37,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from ridempc.sim.changes import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
+from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
 
@@ -132,7 +132,7 @@ class Disturbance(_Frozen):
 
 class ParameterChange(_Frozen):
     """A change of a physical parameter at time ``t``: one knob of
-    :data:`ridempc.sim.changes.KNOBS`, set to ``value`` or to ``scale`` times its nominal
+    :data:`ridempc.sim.knobs.KNOBS`, set to ``value`` or to ``scale`` times its nominal
     value (exactly one of them; ``payload`` takes ``mass`` and ``offset`` instead).
 
     Attributes:
