@@ -507,3 +507,26 @@ def test_the_cli_refuses_a_change_that_does_not_fit(
     assert code == 2
     assert err.startswith("ridempc: error:") and "\n" not in err
     assert "bushing_stiffness" in err and "hovershoes" in err
+
+
+def test_the_readme_table_states_each_knobs_unit_and_range() -> None:
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    for name, knob in KNOBS.items():
+        low, high = knob.allowed().split(" ")[:2]
+        unit = knob.unit if knob.unit != "gain's" else "the gain's"
+        assert f"| `{name}` | {unit} | {low} {high} |" in readme, name
+
+
+def test_the_documented_example_loads_and_fits_cassie_on_the_hovershoes() -> None:
+    import textwrap
+    import tomllib
+
+    import ridempc.scenarios.scenario as scenario_module
+
+    doc = scenario_module.__doc__ or ""
+    example = textwrap.dedent(doc.split("Example::")[1].split("The other knobs")[0])
+    scenario = Scenario(**tomllib.loads(example))
+    assert len(scenario.changes) == 4
+    scene = _scene("hovershoes")
+    assert scene.robot is not None
+    Simulation(scene, make_controller("stand", scene.robot, "hovershoes"), scenario)

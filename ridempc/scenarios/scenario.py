@@ -21,10 +21,32 @@ non-physical values are refused with the field named). Example::
     [noise]                    # sensor noise overrides, see SensorNoise
     vio_latency = 0.05
 
-    [[changes]]
-    t = 5.0
+    [[changes]]                # one knob of ridempc.sim.knobs.KNOBS each
+    t = 5.0                    # [s]; 0 (the default): before the first physics step
     parameter = "floor_friction"
-    value = 0.6
+    value = 0.3                # [-], in (0, 3]
+
+    [[changes]]
+    parameter = "board_mass"
+    body = "left_shoe"         # a body of the board
+    scale = 1.3                # times the nominal mass; exactly one of value, scale
+
+    [[changes]]
+    parameter = "payload"
+    body = "base"              # "base", or a body of the robot
+    mass = 5.0                 # [kg]
+    offset = [0.0, 0.0, 0.1]   # in the body's frame [m]
+
+    [[changes]]
+    parameter = "firmware_gain"
+    gain = "pitch_kp"          # Hovershoes: pitch_kp, pitch_kd, tilt_back_gain; Segway: [gains]
+    scale = 0.8
+
+The other knobs: ``tyre_friction``, ``deck_friction`` [-], ``wheel_radius`` [m],
+``bushing_stiffness`` [N m/rad] and ``bushing_damping`` [N m s/rad] (skateboard),
+``base_payload`` [kg], ``motor_torque_limit`` (scale only) and ``joint_damping``
+[N m s/rad] (``joint``, default all); units, ranges and how each applies are in
+:mod:`ridempc.sim.knobs`.
 """
 
 from __future__ import annotations
