@@ -405,6 +405,10 @@ BAD = [(knob, field, value) for knob in sorted(KNOBS) for field, value in _out_o
 
 def _toml(fields: dict[str, Any]) -> str:
     def literal(v: Any) -> str:
+        if isinstance(v, bool):
+            return str(v).lower()
+        if isinstance(v, list):
+            return "[" + ", ".join(literal(x) for x in v) + "]"
         if isinstance(v, str):
             return f'"{v}"'
         if isinstance(v, float) and not math.isfinite(v):
@@ -445,14 +449,15 @@ def test_out_of_range_is_refused_in_one_line(
         ({"parameter": "payload", "body": "base", "mass": 2.0, "offset": [0, 0, 2]}, "offset"),
         ({"parameter": "floor_friction", "value": 0.5, "mass": 2.0}, "takes no mass"),
         ({"parameter": "gravity", "value": 1.0}, "valid: base_payload"),
+        ({"parameter": "floor_friction", "value": "0.5"}, "changes.0.value"),
+        ({"parameter": "floor_friction", "value": True}, "changes.0.value"),
+        ({"parameter": "floor_friction", "t": "1", "value": 0.5}, "changes.0.t"),
+        ({"parameter": "payload", "body": "base", "mass": 2.0, "offset": [0, 0, True]}, "offset"),
     ],
 )
 def test_malformed_changes_are_refused(tmp_path: Path, fields: dict, words: str) -> None:
-    text = _toml({k: v for k, v in fields.items() if k != "offset"})
-    if "offset" in fields:
-        text += f"offset = {fields['offset']}\n"
     path = tmp_path / "bad.toml"
-    path.write_text(text)
+    path.write_text(_toml(fields))
     with pytest.raises(ConfigError, match=words):
         load_scenario_file(path)
 
@@ -530,3 +535,29 @@ def test_the_documented_example_loads_and_fits_cassie_on_the_hovershoes() -> Non
     scene = _scene("hovershoes")
     assert scene.robot is not None
     Simulation(scene, make_controller("stand", scene.robot, "hovershoes"), scenario)
+
+
+@pytest.mark.parametrize(
+    ("board", "radius"), [("hovershoes", 0.04), ("segway", 0.15), ("skateboard", 0.035)]
+)
+def test_a_new_wheel_radius_keeps_the_deck_and_the_wheels_on_the_ground(
+    board: str, radius: float
+) -> None:
+    """The builder keeps the deck at its height; the axle moves, the wheels still touch z = 0."""
+    sim = _simulation(board, {"parameter": "wheel_radius", "value": radius})
+    scene = sim.scene
+    assert scene.board is not None
+    sites = [
+        _id(scene, mujoco.mjtObj.mjOBJ_SITE, BOARD_PREFIX + n)
+        for n in scene.board.params.platform_sites
+    ]
+    scene.reset()
+    deck = scene.data.site_xpos[sites, 2].copy()
+    try:
+        sim.changes.apply(0, scene.data)
+        np.testing.assert_allclose(scene.data.site_xpos[sites, 2], deck, atol=1e-12)
+        assert scene_module._lowest_point(
+            scene.model, scene.data, scene.board_ground_bodies
+        ) == pytest.approx(0.0, abs=1e-12)
+    finally:
+        sim.changes.restore()

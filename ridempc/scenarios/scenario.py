@@ -152,6 +152,9 @@ class Disturbance(_Frozen):
     per_kg: bool = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
 
 
+_Number = Annotated[float, Field(strict=True)]  # a number: not a string, not a boolean
+
+
 class ParameterChange(_Frozen):
     """A change of a physical parameter at time ``t``: one knob of
     :data:`ridempc.sim.knobs.KNOBS`, set to ``value`` or to ``scale`` times its nominal
@@ -170,15 +173,15 @@ class ParameterChange(_Frozen):
         offset: The payload's position in the body's frame [m].
     """
 
-    t: Time = 0.0
+    t: Annotated[float, Field(ge=0.0, strict=True)] = 0.0
     parameter: str
-    value: float | None = None
-    scale: float | None = None
+    value: _Number | None = None
+    scale: _Number | None = None
     body: str | None = None
     gain: str | None = None
     joint: str | None = None
-    mass: float | None = None
-    offset: Vector3 | None = None
+    mass: _Number | None = None
+    offset: tuple[_Number, _Number, _Number] | None = None
 
     @field_validator("parameter")
     @classmethod
