@@ -24,6 +24,7 @@ from ridempc.errors import ConfigError
 from ridempc.robots import load_robot
 from ridempc.scenarios import load_scenario_file
 from ridempc.scenarios.scenario import CommandEvent, ParameterChange, Scenario
+from ridempc.sim.changes import ScheduledChanges
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.knobs import KNOBS, SCALE_MAX
 from ridempc.sim.motors import MotorCommand
@@ -487,6 +488,8 @@ def test_changes_that_do_not_fit_the_pair_are_refused_before_the_ride(
         _simulation(board, fields)
     assert "\n" not in str(refused.value)
     assert "changes[0]" in str(refused.value)
+    with pytest.raises(ConfigError, match=words):  # checked alone, before anything is made
+        ScheduledChanges(_scene(board), (ParameterChange(**fields),), None, None, "check")
 
 
 def test_a_dead_weight_has_no_motors() -> None:

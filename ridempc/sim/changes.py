@@ -40,8 +40,10 @@ class ScheduledChanges:
     Args:
         scene: The compiled scene.
         changes: The scenario's changes.
-        firmware: The board's firmware (None without a board).
-        driver: The robot's motor drivers (None for a dead weight).
+        firmware: The board's firmware (None without a board, or to check only).
+        driver: The robot's motor drivers (None for a dead weight, or to check only):
+            ``ScheduledChanges(scene, changes, None, None, where)`` right after the scene
+            is built checks the changes before anything else is made.
         where: What to name in errors (the scenario).
 
     Raises:
@@ -66,7 +68,7 @@ class ScheduledChanges:
         self.board_params: BoardParameters | None = (
             scene.board.params if scene.board is not None else None
         )
-        self._nominal_board = self.board_params
+        self.nominal_board = self.board_params
         self._nominal_firmware = firmware.params if firmware is not None else None
         self.torque_scale = 1.0  # what the driver's limits are now, times the description's
         self._scratch: mujoco.MjData | None = None
@@ -114,7 +116,7 @@ class ScheduledChanges:
             getattr(self.model, name)[:] = values
         if self._scratch is not None:
             mujoco.mj_setConst(self.model, self._scratch)
-        self.board_params = self._nominal_board
+        self.board_params = self.nominal_board
         if self.firmware is not None and self._nominal_firmware is not None:
             self.firmware.reconfigure(self._nominal_firmware)
         if self.driver is not None and self.torque_scale != 1.0:

@@ -201,14 +201,15 @@ def _base_payload(changes: ScheduledChanges, change: ParameterChange) -> Action:
 
 
 def _motor_torque_limit(changes: ScheduledChanges, change: ParameterChange) -> Action:
-    driver = changes.driver
-    if driver is None:
+    if changes.scene.robot is None:
         raise changes.refuse(change, "a dead weight has no motors")
     assert change.scale is not None
     scale = change.scale
 
     def act(data: mujoco.MjData) -> None:
-        driver.scale_torque_limit(scale / changes.torque_scale)
+        if changes.driver is None:  # checking only (no simulation)
+            return
+        changes.driver.scale_torque_limit(scale / changes.torque_scale)
         changes.torque_scale = scale
 
     return act
@@ -239,7 +240,9 @@ def _joint_damping(changes: ScheduledChanges, change: ParameterChange) -> Action
     return act
 
 
-def _board_field(path_of: Callable[[ScheduledChanges, ParameterChange], tuple[str, ...]]):
+def _board_field(
+    path_of: Callable[[ScheduledChanges, ParameterChange], tuple[str, ...]],
+) -> Callable[[ScheduledChanges, ParameterChange], Action]:
     """A knob that sets one field of the board's parameters, rebuilt by its builder."""
 
     def prepare(changes: ScheduledChanges, change: ParameterChange) -> Action:
@@ -247,7 +250,7 @@ def _board_field(path_of: Callable[[ScheduledChanges, ParameterChange], tuple[st
         if params is None or changes.scene.board is None:
             raise changes.refuse(change, "there is no board")
         path = path_of(changes, change)
-        nominal = _get(changes._nominal_board, path)
+        nominal = _get(changes.nominal_board, path)
         if not isinstance(nominal, int | float):
             raise changes.refuse(
                 change, f"board '{params.name}' (kind {params.kind}) has no {'.'.join(path)}"
