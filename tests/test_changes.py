@@ -262,7 +262,9 @@ def test_a_slippery_floor_governs_its_contacts() -> None:
     floor = _id(sim.scene, mujoco.mjtObj.mjOBJ_GEOM, "floor")
     try:
         sim.changes.apply(0, sim.scene.data)
-        for pair in np.flatnonzero(model.pair_geom1 == floor):
+        floor_pairs = np.flatnonzero(model.pair_geom1 == floor)  # the world's body comes first
+        assert len(floor_pairs) == 15 + 4  # Cassie's collision geoms, the decks and tyres
+        for pair in floor_pairs:
             other = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, model.pair_geom2[pair])
             expected = {"tyre": 0.15, "deck": 0.45}.get((other or "").split("_")[-1], 0.3)
             assert model.pair_friction[pair, 0] == pytest.approx(expected), other
@@ -564,3 +566,27 @@ def test_a_new_wheel_radius_keeps_the_deck_and_the_wheels_on_the_ground(
         ) == pytest.approx(0.0, abs=1e-12)
     finally:
         sim.changes.restore()
+
+
+def test_a_slippery_deck_governs_the_feet_on_it() -> None:
+    """The Hovershoes' decks (1.5) at 0.5: each foot's pair with a deck grips at 0.5."""
+    sim = _simulation("hovershoes", {"parameter": "deck_friction", "value": 0.5})
+    scene, model = sim.scene, sim.scene.model
+    feet = {
+        g
+        for g in range(model.ngeom)
+        if model.geom_bodyid[g] in scene.foot_bodies and model.geom_contype[g]
+    }
+    try:
+        sim.changes.apply(0, scene.data)
+        on_deck = [  # MuJoCo orders each pair's geoms by body
+            p
+            for p in range(model.npair)
+            if {model.pair_geom1[p], model.pair_geom2[p]} & scene.deck_geoms
+            and {model.pair_geom1[p], model.pair_geom2[p]} & feet
+        ]
+        assert len(on_deck) == 2 * len(feet)  # each foot with each shoe's deck
+        assert np.allclose(model.pair_friction[on_deck, 0], 0.5)
+    finally:
+        sim.changes.restore()
+    assert np.allclose(model.pair_friction[on_deck, 0], 1.5)

@@ -87,8 +87,8 @@ def add_surface_pairs(
         surfaces: Geom ids of the surfaces (floor first, then the decks).
 
     Returns:
-        The recompiled model (same element ids, plus the pairs; geom 1 of each pair is the
-        surface).
+        The recompiled model (same element ids, plus the pairs, each pair's geoms in MuJoCo's
+        order: by body).
     """
     geoms = {int(g.id): g for g in spec.geoms}
     if any(model.geom_priority[g] != model.geom_priority[0] for g in range(model.ngeom)):
