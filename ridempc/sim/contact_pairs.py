@@ -25,9 +25,19 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["add_surface_pairs", "can_collide", "set_pair_friction"]
+__all__ = ["add_surface_pairs", "can_collide", "collision_geoms", "set_pair_friction"]
 
 _MINVAL = mujoco.mjMINVAL  # MuJoCo's own threshold for a zero solmix
+
+
+def collision_geoms(model: mujoco.MjModel, bodies: Iterable[int]) -> frozenset[int]:
+    """The geoms of ``bodies`` that take part in contacts (visual ones do not)."""
+    wanted = set(bodies)
+    return frozenset(
+        g
+        for g in range(model.ngeom)
+        if model.geom_bodyid[g] in wanted and (model.geom_contype[g] or model.geom_conaffinity[g])
+    )
 
 
 def can_collide(model: mujoco.MjModel, g1: int, g2: int) -> bool:

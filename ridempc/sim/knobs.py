@@ -33,6 +33,7 @@ from pydantic import ValidationError
 
 from ridempc.boards.parameters import BoardParameters
 from ridempc.sim.board_edits import board_edits
+from ridempc.sim.contact_pairs import collision_geoms
 from ridempc.sim.scene import BOARD_PREFIX, Scene
 
 if TYPE_CHECKING:
@@ -119,15 +120,6 @@ def _friction(geoms_of: Callable[[Scene], frozenset[int]], what: str) -> Callabl
         return act
 
     return prepare
-
-
-def _board_geoms(scene: Scene, bodies: frozenset[int]) -> frozenset[int]:
-    model = scene.model
-    return frozenset(
-        g
-        for g in range(model.ngeom)
-        if model.geom_bodyid[g] in bodies and (model.geom_contype[g] or model.geom_conaffinity[g])
-    )
 
 
 def _board_mass(changes: ScheduledChanges, change: ParameterChange) -> Action:
@@ -345,7 +337,7 @@ KNOBS: Mapping[str, Knob] = MappingProxyType(
             0.0,
             3.0,
             "the board's tyres' friction",
-            _friction(lambda s: _board_geoms(s, s.board_ground_bodies), "board wheel"),
+            _friction(lambda s: collision_geoms(s.model, s.board_ground_bodies), "board wheel"),
         ),
         "deck_friction": _knob(
             "-",

@@ -3,7 +3,9 @@
 The robot's MJCF stays untouched on disk; the scene builder edits a copy of its spec to
 add the floor, light, the IMU's MuJoCo sensors and the physics options, and places the
 robot in its standing keyframe with its lowest foot point ``FOOT_CLEARANCE`` above the
-support, so the run starts settled (no interpenetration, no launch).
+support, so the run starts settled (no interpenetration, no launch). The floor's and the
+decks' contacts are explicit pairs (:mod:`ridempc.sim.contact_pairs`), so that a scenario
+can change their friction.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from ridempc.boards.board import Board
 from ridempc.errors import ConfigError
 from ridempc.mjcf import STIFF_CONTACT, add_imu_sensors
 from ridempc.robots.robot import Robot
-from ridempc.sim.contact_pairs import add_surface_pairs
+from ridempc.sim.contact_pairs import add_surface_pairs, collision_geoms
 
 __all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
 
@@ -363,11 +365,7 @@ def _deck_geoms(model: mujoco.MjModel, board: Board | None) -> list[int]:
         for n in board.params.platform_sites
     ]
     bodies = {int(model.site_bodyid[s]) for s in sites if s >= 0}  # a missing one: refused later
-    return [
-        g
-        for g in range(model.ngeom)
-        if model.geom_bodyid[g] in bodies and (model.geom_contype[g] or model.geom_conaffinity[g])
-    ]
+    return sorted(collision_geoms(model, bodies))
 
 
 def _check_feet_over(
