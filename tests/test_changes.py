@@ -590,3 +590,23 @@ def test_a_slippery_deck_governs_the_feet_on_it() -> None:
     finally:
         sim.changes.restore()
     assert np.allclose(model.pair_friction[on_deck, 0], 1.5)
+
+
+def test_successive_torque_limits_are_each_a_scale_of_the_description() -> None:
+    """0.5 at t = 0, 0.8 at t = 0.1 s: the peak torque is 0.5, then 0.8 times the motor's
+    own, and the motor's own after the run (``scale_torque_limit`` multiplies what is)."""
+    sim = _simulation(
+        "skateboard",
+        {"parameter": "motor_torque_limit", "scale": 0.5},
+        {"parameter": "motor_torque_limit", "t": 0.1, "scale": 0.8},
+    )
+    peak = _peak_torque(sim)
+    tick = round(0.1 * sim.scene.physics_hz)
+    try:
+        assert sim.changes.apply(0, sim.scene.data)
+        assert _peak_torque(sim) == pytest.approx(0.5 * peak)
+        assert sim.changes.apply(tick, sim.scene.data)
+        assert _peak_torque(sim) == pytest.approx(0.8 * peak)
+    finally:
+        sim.changes.restore()
+    assert _peak_torque(sim) == pytest.approx(peak)

@@ -9,7 +9,8 @@ applies and how (:data:`KNOBS`).
   ``firmware_gain`` (``gain``): a field of the board's parameters, checked by the board's own
   parameter model; the board's builder says what follows (:mod:`ridempc.sim.board_edits`:
   tyre size, wheel inertia, the axle under a deck that keeps its height, joint springs), and
-  the firmware runs on the new parameters (its speed estimate uses the new radius);
+  the firmware runs on the new parameters (its speed estimate uses the new radius); the
+  Hovershoes' deck clears its wheel by 1 mm, so their parameter model refuses a larger one;
 - ``payload`` (``body``, ``mass`` [kg], ``offset`` [m] in the body frame): a point mass on
   a rider body (``base`` for the base), its mass, centre of mass and inertia updated;
   ``base_payload`` [kg]: one at the base's centre of mass;
