@@ -94,7 +94,7 @@ class Knob:
 
 SCALE_MAX: float = 10.0  # a scale above this is a typing error, not a robustness study
 PAYLOAD_MASS_MAX: float = 100.0  # [kg] three Cassies
-PAYLOAD_OFFSET_MAX: float = 1.0  # [m] from the body's origin, along each axis
+PAYLOAD_OFFSET_MAX: float = 1.0  # [m] per axis: farther is off the robot (Cassie is 1 m tall)
 
 
 def _bodies_named(model: mujoco.MjModel, bodies: frozenset[int], prefix: str = "") -> dict:
@@ -330,6 +330,7 @@ def _knob(
 
 KNOBS: Mapping[str, Knob] = MappingProxyType(
     {
+        # frictions: rubber on dry concrete is about 1; 3 is beyond any tyre, sole or deck
         "floor_friction": _knob(
             "-", 0.0, 3.0, "the floor's friction", _friction(lambda s: s.ground_geoms, "floor")
         ),
@@ -347,8 +348,11 @@ KNOBS: Mapping[str, Knob] = MappingProxyType(
             "the board's platforms' friction",
             _friction(lambda s: s.deck_geoms, "board platform"),
         ),
+        # a 100 kg board body is no longer a personal board
         "board_mass": _knob("kg", 0.0, 100.0, "one board body's mass", _board_mass, where="body"),
+        # a 1 m wheel is a unicycle's; the boards' are 3-13 cm
         "wheel_radius": _knob("m", 0.0, 0.5, "the board's wheel radius", _board_field(_wheel)),
+        # bushings: the skateboard's are 12 N m/rad and 0.3 N m s/rad; 1000 is a rigid truck
         "bushing_stiffness": _knob(
             "N m/rad", 0.0, 1000.0, "each truck's bushing stiffness", _board_field(_bushing)
         ),
@@ -360,6 +364,7 @@ KNOBS: Mapping[str, Knob] = MappingProxyType(
             _board_field(_bushing),
             low_open=False,
         ),
+        # the firmwares' largest gain is the Segway's pitch_kp, 250 N m/rad
         "firmware_gain": _knob(
             "gain's",
             0.0,
@@ -386,6 +391,7 @@ KNOBS: Mapping[str, Knob] = MappingProxyType(
             _base_payload,
             forms=("value",),
         ),
+        # five times its peak torque is no longer the same motor
         "motor_torque_limit": _knob(
             "-",
             0.0,
@@ -394,6 +400,7 @@ KNOBS: Mapping[str, Knob] = MappingProxyType(
             _motor_torque_limit,
             forms=("scale",),
         ),
+        # the robots' joints have 0.01-1 N m s/rad
         "joint_damping": _knob(
             "N m s/rad",
             0.0,
