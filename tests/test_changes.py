@@ -455,6 +455,13 @@ def test_out_of_range_is_refused_in_one_line(
         ({"parameter": "floor_friction", "value": "0.5"}, "changes.0.value"),
         ({"parameter": "floor_friction", "value": True}, "changes.0.value"),
         ({"parameter": "floor_friction", "t": "1", "value": 0.5}, "changes.0.t"),
+        ({"parameter": "floor_friction", "t": math.inf, "value": 0.5}, "changes.0.t"),
+        ({"parameter": "floor_friction", "t": math.nan, "value": 0.5}, "changes.0.t"),
+        ({"parameter": "floor_friction", "t": -1.0, "value": 0.5}, "changes.0.t"),
+        ({"parameter": "payload", "body": "base"}, "needs a mass"),
+        ({"parameter": "payload", "mass": 1.0}, "needs a body"),
+        ({"parameter": "payload", "body": 3, "mass": 1.0}, "changes.0.body"),
+        ({"parameter": "payload", "body": "base", "mass": 1.0, "offset": [0, 0]}, "offset"),
         ({"parameter": "payload", "body": "base", "mass": 2.0, "offset": [0, 0, True]}, "offset"),
     ],
 )

@@ -173,7 +173,7 @@ class ParameterChange(_Frozen):
         offset: The payload's position in the body's frame [m].
     """
 
-    t: Annotated[float, Field(ge=0.0, strict=True)] = 0.0
+    t: Annotated[float, Field(ge=0.0, le=3600.0, strict=True)] = 0.0  # no ride is longer
     parameter: str
     value: _Number | None = None
     scale: _Number | None = None
@@ -218,7 +218,9 @@ class ParameterChange(_Frozen):
         if not payload and (self.mass is not None or self.offset is not None):
             raise ValueError(f"{self.parameter} takes no mass or offset (a payload does)")
         if payload:
-            if self.mass is None or not knob.admits(self.mass):
+            if self.mass is None:
+                raise ValueError(f"payload needs a mass in {knob.allowed()}")
+            if not knob.admits(self.mass):
                 raise ValueError(f"payload mass = {self.mass} is outside {knob.allowed()}")
             offset = self.offset or (0.0, 0.0, 0.0)
             if not all(math.isfinite(x) and abs(x) <= PAYLOAD_OFFSET_MAX for x in offset):
