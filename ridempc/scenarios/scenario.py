@@ -21,10 +21,32 @@ non-physical values are refused with the field named). Example::
     [noise]                    # sensor noise overrides, see SensorNoise
     vio_latency = 0.05
 
-    [[changes]]
-    t = 5.0
+    [[changes]]                # one knob of ridempc.sim.knobs.KNOBS each
+    t = 5.0                    # [s]; 0 (the default): before the first physics step
     parameter = "floor_friction"
-    value = 0.6
+    value = 0.3                # [-], in (0, 3]
+
+    [[changes]]
+    parameter = "board_mass"
+    body = "left_shoe"         # a body of the board
+    scale = 1.3                # times the nominal mass; exactly one of value, scale
+
+    [[changes]]
+    parameter = "payload"
+    body = "base"              # "base", or a body of the robot
+    mass = 5.0                 # [kg]
+    offset = [0.0, 0.0, 0.1]   # in the body's frame [m]
+
+    [[changes]]
+    parameter = "firmware_gain"
+    gain = "pitch_kp"          # Hovershoes: pitch_kp, pitch_kd, tilt_back_gain; Segway: [gains]
+    scale = 0.8
+
+The other knobs: ``tyre_friction``, ``deck_friction`` [-], ``wheel_radius`` [m],
+``bushing_stiffness`` [N m/rad] and ``bushing_damping`` [N m s/rad] (skateboard),
+``base_payload`` [kg], ``motor_torque_limit`` (scale only) and ``joint_damping``
+[N m s/rad] (``joint``, default all); units, ranges and how each applies are in
+:mod:`ridempc.sim.knobs`.
 """
 
 from __future__ import annotations
@@ -35,8 +57,9 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
 
@@ -129,12 +152,83 @@ class Disturbance(_Frozen):
     per_kg: bool = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
 
 
-class ParameterChange(_Frozen):
-    """A change of a physical parameter during the run."""
+_Number = Annotated[float, Field(strict=True)]  # a number: not a string, not a boolean
 
-    t: Time
-    parameter: Literal["floor_friction", "base_payload"]  # [-] / [kg] added to the base
-    value: float
+
+class ParameterChange(_Frozen):
+    """A change of a physical parameter at time ``t``: one knob of
+    :data:`ridempc.sim.knobs.KNOBS`, set to ``value`` or to ``scale`` times its nominal
+    value (exactly one of them; ``payload`` takes ``mass`` and ``offset`` instead).
+
+    Attributes:
+        t: When it takes effect [s] (0: before the first physics step).
+        parameter: The knob's name.
+        value: The new value [the knob's unit].
+        scale: The new value over the nominal one [-].
+        body: Where a ``board_mass`` (a board body) or ``payload`` (a rider body, ``base``
+            for the base) applies.
+        gain: Which firmware gain ``firmware_gain`` sets.
+        joint: The one robot joint ``joint_damping`` sets (default: all of them).
+        mass: The payload's mass [kg].
+        offset: The payload's position in the body's frame [m].
+    """
+
+    t: Annotated[float, Field(ge=0.0, le=3600.0, strict=True)] = 0.0  # no ride is longer
+    parameter: str
+    value: _Number | None = None
+    scale: _Number | None = None
+    body: str | None = None
+    gain: str | None = None
+    joint: str | None = None
+    mass: _Number | None = None
+    offset: tuple[_Number, _Number, _Number] | None = None
+
+    @field_validator("parameter")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if name not in KNOBS:
+            raise ValueError(f"unknown knob '{name}' (valid: {', '.join(sorted(KNOBS))})")
+        return name
+
+    @model_validator(mode="after")
+    def _in_range(self) -> ParameterChange:
+        knob = KNOBS[self.parameter]
+        given = [f for f in ("value", "scale") if getattr(self, f) is not None]
+        if knob.forms and len(given) != 1:
+            raise ValueError(
+                f"{self.parameter} takes exactly one of "
+                f"{' or '.join(f for f in ('value', 'scale') if f in knob.forms)}"
+            )
+        for form in given:
+            if form not in knob.forms:
+                raise ValueError(f"{self.parameter} takes no {form}")
+        if self.value is not None and not knob.admits(self.value):
+            raise ValueError(f"{self.parameter} value = {self.value} is outside {knob.allowed()}")
+        if self.scale is not None and not (
+            0.0 < self.scale <= SCALE_MAX and (knob.forms != {"scale"} or knob.admits(self.scale))
+        ):
+            top = knob.high if knob.forms == {"scale"} else SCALE_MAX
+            raise ValueError(f"{self.parameter} scale = {self.scale} is outside (0, {top:g}]")
+        for name in ("body", "gain", "joint"):
+            if getattr(self, name) is not None and knob.where != name:
+                raise ValueError(f"{self.parameter} takes no {name}")
+        if knob.where is not None and knob.where_required and getattr(self, knob.where) is None:
+            raise ValueError(f"{self.parameter} needs a {knob.where}")
+        payload = self.parameter == "payload"
+        if not payload and (self.mass is not None or self.offset is not None):
+            raise ValueError(f"{self.parameter} takes no mass or offset (a payload does)")
+        if payload:
+            if self.mass is None:
+                raise ValueError(f"payload needs a mass in {knob.allowed()}")
+            if not knob.admits(self.mass):
+                raise ValueError(f"payload mass = {self.mass} is outside {knob.allowed()}")
+            offset = self.offset or (0.0, 0.0, 0.0)
+            if not all(math.isfinite(x) and abs(x) <= PAYLOAD_OFFSET_MAX for x in offset):
+                raise ValueError(
+                    f"payload offset = {list(offset)} is outside [-{PAYLOAD_OFFSET_MAX:g}, "
+                    f"{PAYLOAD_OFFSET_MAX:g}] m per axis"
+                )
+        return self
 
 
 class PushOff(_Frozen):

@@ -103,3 +103,9 @@ class MotorDriver:
 
     def apply(self, data: mujoco.MjData) -> None:
         data.ctrl[self._actuators] = self.torque(data) / self._gear
+
+    def scale_torque_limit(self, scale: float) -> None:
+        """Multiply every motor's peak torque by ``scale`` [-] (a scenario's weaker or
+        stronger motors), from the next :meth:`torque` on."""
+        self._limit = self._limit * scale
+        self._negative_limit = -self._limit
