@@ -17,6 +17,17 @@ __all__ = [
 ]
 
 
+_SCALARS = (str, int, float, bool, type(None))
+
+
+def _shown(value: object) -> str:
+    """A bad input as the user wrote it (TOML spelling for booleans), cut to one short line."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 class RidempcError(Exception):
     """Base class of every error ridempc raises on purpose."""
 
@@ -39,11 +50,14 @@ class ConfigError(RidempcError, ValueError):
 
     @classmethod
     def from_validation(cls, path: Path | str, exc: ValidationError) -> ConfigError:
-        """One line naming the file, the first bad field and what was expected."""
+        """One line naming the file, the first bad field, its value and what is allowed."""
         first = exc.errors()[0]
         where = ".".join(str(part) for part in first["loc"]) or "(top level)"
         more = f" (and {exc.error_count() - 1} more)" if exc.error_count() > 1 else ""
-        return cls(f"{path}: field '{where}': {first['msg']}{more}")
+        got = ""
+        if first["type"] != "missing" and isinstance(first.get("input"), _SCALARS):
+            got = f", got {_shown(first['input'])}"
+        return cls(f"{path}: field '{where}': {first['msg']}{got}{more}")
 
 
 class SimulationDiverged(RidempcError, RuntimeError):

@@ -11,7 +11,13 @@ from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["atomic_write", "atomic_write_json", "atomic_write_npz", "atomic_write_text"]
+__all__ = [
+    "atomic_savefig",
+    "atomic_write",
+    "atomic_write_json",
+    "atomic_write_npz",
+    "atomic_write_text",
+]
 
 _UMASK = os.umask(0)
 os.umask(_UMASK)
@@ -50,5 +56,14 @@ def atomic_write_json(path: Path, payload: Mapping[str, Any]) -> None:
 def atomic_write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
     def write(stream: IO[bytes]) -> None:
         np.savez_compressed(stream, **arrays)  # type: ignore[arg-type]
+
+    atomic_write(path, write)
+
+
+def atomic_savefig(figure: Any, path: Path, dpi: int) -> None:
+    """Save a Matplotlib figure as PNG atomically (no half-drawn image after an error)."""
+
+    def write(stream: IO[bytes]) -> None:
+        figure.savefig(stream, format="png", dpi=dpi)
 
     atomic_write(path, write)

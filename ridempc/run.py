@@ -2,29 +2,38 @@
 
 The output folder receives ``log.npz`` (time series), optionally ``video.mp4``,
 ``snapshots.png`` (a strip of still frames) and ``plots.png``, and last of all
-``summary.json``. Every file is written atomically, and a stale ``summary.json`` from an
-earlier run is removed before the new run starts, so an interrupted run never leaves a
-summary that looks complete.
+``summary.json``. Everything is checked before anything is written (:func:`check_request`);
+every file is written atomically, and every file an earlier run wrote there is removed
+before the new run starts (:mod:`ridempc.results`), so a folder never mixes two runs and an
+interrupted run never leaves a summary that looks complete.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ridempc.boards import NO_BOARD, load_board
+from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
 from ridempc.errors import ConfigError
 from ridempc.io import atomic_write_json, atomic_write_npz
+from ridempc.results import clear_run
 from ridempc.robots import load_robot
-from ridempc.scenarios import resolve_scenario
+from ridempc.scenarios import Scenario, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
+from ridempc.units import MAX_DURATION
 
-__all__ = ["RideRequest", "ride"]
+if TYPE_CHECKING:
+    from ridempc.boards.board import Board
+    from ridempc.controllers.base import Controller
+    from ridempc.robots.robot import Robot
+
+__all__ = ["CheckedRide", "RideRequest", "check_request", "ride"]
 
 DEFAULT_SCENARIO = "stand-still"
 
@@ -64,14 +73,43 @@ class RideRequest:
     physics_hz: int = DEFAULT_PHYSICS_HZ
 
 
-def ride(request: RideRequest) -> dict[str, Any]:
-    """Run one ride and write its results; returns the summary.
+@dataclass(frozen=True)
+class CheckedRide:
+    """A request with every name, file and number resolved and checked; nothing written yet.
+
+    Attributes:
+        robot: The robot, or None for a dead weight.
+        board: The board, or None for flat ground.
+        board_name: The board's name (``none`` for flat ground).
+        scenario: The scenario, with the request's duration.
+        controller: The controller, or None for a dead weight.
+        dead_weight: Mass of the dead weight [kg], or None with a robot.
+        out: The output folder (writable, or creatable).
+    """
+
+    robot: Robot | None
+    board: Board | None
+    board_name: str
+    scenario: Scenario
+    controller: Controller | None
+    dead_weight: float | None
+    out: Path
+
+
+def check_request(request: RideRequest) -> CheckedRide:
+    """Check everything a ride needs, before anything is written or simulated.
 
     Raises:
-        UnknownNameError: A name that does not exist (before anything is written).
-        ConfigError: A malformed scenario or parameter file, or a scenario that does not
-            apply to the robot-board pair.
+        UnknownNameError: A name that does not exist.
+        ConfigError: An output folder that cannot be written, a malformed scenario or
+            parameter file, a duration out of range, or a scenario that does not apply to
+            the robot-board pair.
     """
+    out = writable_dir(Path(request.out), "--out folder")
+    if request.duration is not None and not 0.0 < request.duration <= MAX_DURATION:
+        raise ConfigError(  # NaN fails the comparison too
+            f"--duration {request.duration}: allowed: seconds in (0, {MAX_DURATION:g}]"
+        )
     robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
     board = load_board(request.board)
     board_name = board.name if board is not None else NO_BOARD
@@ -87,13 +125,27 @@ def ride(request: RideRequest) -> dict[str, Any]:
             raise ConfigError(f"robot '{NO_ROBOT}' (a dead weight) needs a board to ride")
         dead_weight = load_robot(board.params.dead_weight_robot).mass
     if request.duration is not None:
-        if request.duration <= 0:
-            raise ConfigError(f"--duration must be positive, got {request.duration}")
         scenario = scenario.with_duration(request.duration)
+    return CheckedRide(robot, board, board_name, scenario, controller, dead_weight, out)
 
-    out = Path(request.out)
+
+def ride(request: RideRequest) -> dict[str, Any]:
+    """Run one ride and write its results; returns the summary.
+
+    Every file an earlier run wrote in the output folder (:data:`~ridempc.results.RUN_FILES`)
+    is removed before the ride starts; nothing else there is touched.
+
+    Raises:
+        UnknownNameError: A name that does not exist (before anything is written).
+        ConfigError: See :func:`check_request` (before anything is written).
+    """
+    checked = check_request(request)
+    robot, board, board_name = checked.robot, checked.board, checked.board_name
+    scenario, controller, dead_weight = checked.scenario, checked.controller, checked.dead_weight
+
+    out = checked.out
+    clear_run(out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.json").unlink(missing_ok=True)
 
     scene = build_scene(
         robot,
@@ -123,7 +175,6 @@ def ride(request: RideRequest) -> dict[str, Any]:
 
         viewer = LiveViewer(scene.model, scene.data)
         frame_callbacks.append(viewer)
-    (out / "snapshots.png").unlink(missing_ok=True)
     if request.snapshots > 0:
         from ridempc.sim.snapshots import SnapshotStrip
 
@@ -149,15 +200,19 @@ def ride(request: RideRequest) -> dict[str, Any]:
         ground_truth=request.ground_truth,
         on_frame=on_frame if frame_callbacks else None,
     )
+    finished = False
     try:
         result = simulation.run()
+        finished = True
     finally:
         if video is not None:
-            video.close(keep=True)
+            video.close(keep=finished)
         if viewer is not None:
             viewer.close()
-        if strip is not None:
+        if strip is not None and finished:
             strip.close(scene.data)
+        elif strip is not None:
+            strip.discard()
 
     atomic_write_npz(out / "log.npz", result.log)
     files = ["log.npz"]

@@ -11,27 +11,25 @@ with its own figures (wheel radius, rake angles, ...), every one checked to be p
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from ridempc.tomlfile import read_toml, validate
+from ridempc.units import Angle, CheckedModel, Friction, NonNegative, Positive, Rate, Real
 
 __all__ = [
     "Angle",
     "BoardParameters",
+    "Friction",
     "NonNegative",
     "Positive",
+    "Real",
     "read_board_toml",
     "validate_board_parameters",
 ]
 
-Positive = Annotated[float, Field(gt=0.0)]
-NonNegative = Annotated[float, Field(ge=0.0)]
-Angle = Annotated[float, Field(gt=0.0, lt=90.0, description="[deg], in (0, 90)")]
-
-
-class BoardParameters(BaseModel):
+class BoardParameters(CheckedModel):
     """What every board states.
 
     Attributes:
@@ -45,11 +43,9 @@ class BoardParameters(BaseModel):
         dead_weight_robot: Robot whose mass the default dead weight has.
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
     name: str = Field(pattern=r"^[a-z0-9][a-z0-9_-]*$")
     kind: str
-    firmware_hz: Positive
+    firmware_hz: Rate
     platform_sites: tuple[str, ...] = Field(min_length=1)
     ground_bodies: tuple[str, ...] = Field(min_length=1)
     dead_weight_robot: str

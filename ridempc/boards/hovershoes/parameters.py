@@ -11,14 +11,15 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator
+from pydantic import ValidationInfo, field_validator
 
-from ridempc.boards.parameters import BoardParameters, NonNegative, Positive
+from ridempc.boards.parameters import BoardParameters, Friction, NonNegative, Positive
+from ridempc.units import CheckedModel
 
 __all__ = ["HovershoesParameters", "HovershoesReducedParameters"]
 
 
-class HovershoesReducedParameters(BaseModel):
+class HovershoesReducedParameters(CheckedModel):
     """Identified parameters of the reduced model, paper eq. (4)-(8) (see ``reduced.py``).
 
     Attributes:
@@ -30,8 +31,6 @@ class HovershoesReducedParameters(BaseModel):
         c4: Forward force per radian of pitch [N / rad].
         m: Loaded mass (shoe and its load) the figures were identified with [kg].
     """
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
 
     J_theta: Positive
     c1: Positive
@@ -77,7 +76,7 @@ class HovershoesParameters(BoardParameters):
     platform_thickness: Positive
     platform_height: Positive
     shoe_spacing: Positive
-    platform_friction: Positive
+    platform_friction: Friction
     motor_torque_limit: Positive
     motor_speed_limit: Positive
     speed_limit: Positive

@@ -11,14 +11,15 @@ from __future__ import annotations
 
 from typing import Literal, Self
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
-from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive
+from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive, Real
+from ridempc.units import CheckedModel
 
 __all__ = ["SegwayGains", "SegwayParameters", "SegwayReducedParameters"]
 
 
-class SegwayGains(BaseModel):
+class SegwayGains(CheckedModel):
     """The firmware's gains and limits (table ``[gains]``).
 
     Balance, total over both wheels (eq. in :mod:`ridempc.boards.segway.firmware`):
@@ -36,8 +37,6 @@ class SegwayGains(BaseModel):
         yaw_rate_kp: Differential wheel torque per yaw-rate error [N m s / rad].
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
     pitch_kp: Positive
     pitch_kd: Positive
     speed_kv: NonNegative
@@ -47,7 +46,7 @@ class SegwayGains(BaseModel):
     yaw_rate_kp: Positive
 
 
-class SegwayReducedParameters(BaseModel):
+class SegwayReducedParameters(CheckedModel):
     """Identified reduced model (table ``[reduced]``; see :mod:`ridempc.boards.segway.reduced`).
 
     Attributes:
@@ -64,16 +63,14 @@ class SegwayReducedParameters(BaseModel):
         tau_turn: Time constant of the yaw rate's lag [s].
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
     pitch_inertia: Positive
     c1: Positive
     c2: Positive
-    c3: float
+    c3: Real
     c4: Positive
-    c5: float
-    c6: float = 0.0
-    c7: float = 0.0
+    c5: Real
+    c6: Real = 0.0
+    c7: Real = 0.0
     mass: Positive
     k_turn: Positive
     tau_turn: Positive

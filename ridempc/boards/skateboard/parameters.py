@@ -15,14 +15,15 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
-from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive
+from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive, Real
+from ridempc.units import CheckedModel
 
 __all__ = ["SkateboardParameters", "SkateboardReducedParameters"]
 
 
-class SkateboardReducedParameters(BaseModel):
+class SkateboardReducedParameters(CheckedModel):
     """Identified reduced model: deck roll eq. (6)-(7) and the kinematic gain of eq. (14).
 
     Attributes:
@@ -32,8 +33,6 @@ class SkateboardReducedParameters(BaseModel):
         steer_gain: Yaw rate per forward speed and sine of roll,
             :math:`1 / K_{board} = (\\cot\\gamma_f + \\cot\\gamma_r) / L` [1 / m].
     """
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
 
     roll_inertia: Positive
     roll_stiffness: Positive
@@ -84,7 +83,7 @@ class SkateboardParameters(BoardParameters):
     rake_rear: Angle
     bushing_stiffness: Positive
     bushing_damping: NonNegative
-    roll_limit: float = Field(gt=0.0, lt=0.5, description="[rad]")
+    roll_limit: Real = Field(gt=0.0, lt=0.5, description="[rad]")
     wheel_friction_torque: NonNegative
     wheel_damping: NonNegative
     reduced: SkateboardReducedParameters | None = None

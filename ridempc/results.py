@@ -1,0 +1,58 @@
+"""The files ridempc writes into an ``--out`` folder, listed once, and their removal.
+
+A run that starts in a folder an earlier run wrote removes every file that earlier run
+wrote before it writes its own, so a folder never mixes two runs. It removes only the files
+listed here (and their temporary files, left by a run that was killed): anything else in
+the folder, such as a user's notes, is never touched, and a folder that is then empty is
+removed only where ridempc made it (a compare's per-controller and per-seed folders).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+__all__ = ["COMPARISON_FILES", "RUN_FILES", "clear_comparison", "clear_run"]
+
+# What ``ridempc sim`` writes (summary.json first: its absence marks an unfinished run).
+RUN_FILES: tuple[str, ...] = ("summary.json", "log.npz", "plots.png", "video.mp4", "snapshots.png")
+# What ``ridempc compare`` writes beside its ``<controller>/seed-<k>/`` run folders.
+COMPARISON_FILES: tuple[str, ...] = ("comparison.json", "comparison.md", "overlay.png")
+
+_SEED_FOLDER = re.compile(r"^seed-[0-9]+$")
+
+
+def _remove(folder: Path, names: tuple[str, ...]) -> None:
+    for name in names:
+        (folder / name).unlink(missing_ok=True)
+        for stale in folder.glob(f".{name}.*"):  # its temporary files: ".<name>.<...>"
+            if stale.is_file():
+                stale.unlink(missing_ok=True)
+
+
+def clear_run(folder: Path) -> None:
+    """Remove what an earlier ``ridempc sim`` wrote in ``folder`` (nothing if it is new)."""
+    if folder.is_dir():
+        _remove(folder, RUN_FILES)
+
+
+def clear_comparison(folder: Path) -> None:
+    """Remove what an earlier ``ridempc compare`` wrote in ``folder``: its table, its plot
+    and every ``<controller>/seed-<k>/`` run, whatever controllers and seeds it had."""
+    if not folder.is_dir():
+        return
+    _remove(folder, COMPARISON_FILES)
+    for controller in [p for p in folder.iterdir() if p.is_dir() and not p.is_symlink()]:
+        seeds = [p for p in controller.iterdir() if p.is_dir() and _SEED_FOLDER.match(p.name)]
+        for seed in seeds:
+            clear_run(seed)
+            _remove_if_empty(seed)
+        if seeds:
+            _remove_if_empty(controller)
+
+
+def _remove_if_empty(folder: Path) -> None:
+    try:
+        folder.rmdir()
+    except OSError:  # not empty: it holds files ridempc did not write
+        pass
