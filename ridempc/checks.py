@@ -69,8 +69,7 @@ def text_file(path: Path, what: str) -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(
-            f"{path}: {what} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
-            f"{exc.start})"
+            f"{path}: {what} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start})"
         ) from None
 
 
@@ -95,7 +94,9 @@ def _probe(folder: Path, path: Path, what: str) -> None:
         with tempfile.TemporaryFile(dir=folder, prefix=".ridempc-probe-"):
             pass
     except OSError as exc:
-        raise ConfigError(f"{path}: {what} is not writable ({exc.strerror})") from None
+        raise ConfigError(
+            f"{path}: {what} is not writable: no file can be created in {folder} ({exc.strerror})"
+        ) from None
 
 
 def writable_dir(path: Path, what: str) -> Path:

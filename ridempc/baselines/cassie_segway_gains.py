@@ -33,7 +33,6 @@ __all__ = [
 DEFAULT_GAINS_FILE = Path(__file__).with_name("cassie_segway.toml")
 
 
-
 class _Frozen(CheckedModel):
     """Strict numbers, no NaN, no unknown keys, immutable."""
 
@@ -46,8 +45,12 @@ class LoopGains(_Frozen):
     ``max_rate``.
     """
 
-    feedforward: Real = Field(description="Shift per unit of command [m per m/s or rad/s].")
-    feedforward_rate: Real = Field(
+    # The shift is clamped to max_shift (<= 0.12 m): a feedforward above 1 m per unit of
+    # command would saturate it at an eighth of a unit.
+    feedforward: Annotated[Real, Field(ge=-1.0, le=1.0)] = Field(
+        description="Shift per unit of command [m per m/s or rad/s]."
+    )
+    feedforward_rate: Annotated[Real, Field(ge=-1.0, le=1.0)] = Field(
         description="Shift per unit of the command's rate [m per m/s^2 or rad/s^2]."
     )
     kp: NonNegative = Field(description="Shift per unit of error [m per m/s or rad/s].")

@@ -32,7 +32,6 @@ __all__ = [
 DEFAULT_GAINS_FILE = Path(__file__).with_name("cassie_standing.toml")
 
 
-
 class _Frozen(CheckedModel):
     """Strict numbers, no NaN, no unknown keys, immutable."""
 

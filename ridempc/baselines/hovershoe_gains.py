@@ -35,7 +35,6 @@ __all__ = [
 DEFAULT_GAINS_FILE = Path(__file__).with_name("cassie_hovershoes.toml")
 
 
-
 class _Frozen(CheckedModel):
     """Strict numbers, no NaN, no unknown keys, immutable."""
 

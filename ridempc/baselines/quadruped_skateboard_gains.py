@@ -31,7 +31,6 @@ __all__ = [
 DEFAULT_GAINS_FILE = Path(__file__).with_name("quadruped_skateboard.toml")
 
 
-
 class _Frozen(CheckedModel):
     """Strict numbers, no NaN, no unknown keys, immutable."""
 

@@ -29,6 +29,7 @@ __all__ = [
     "validate_board_parameters",
 ]
 
+
 class BoardParameters(CheckedModel):
     """What every board states.
 

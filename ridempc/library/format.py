@@ -33,6 +33,7 @@ from pydantic import Field
 
 from ridempc.units import (
     CheckedModel,
+    Count,
     NonNegative,
     NonNegativeCount,
     Positive,
@@ -123,7 +124,7 @@ class Manifest(_Strict):
     """``manifest.json`` of one robot-board pair."""
 
     format: Literal["ridempc-motion-library"]
-    version: Literal[1]
+    version: Annotated[Count, Field(ge=VERSION, le=VERSION)]  # the only version there is
     robot: str
     board: str
     entries: tuple[EntryRecord, ...]

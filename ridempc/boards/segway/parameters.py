@@ -9,7 +9,7 @@ a :class:`~ridempc.errors.ConfigError` naming the field.
 
 from __future__ import annotations
 
-from typing import Literal, Self
+from typing import Annotated, Literal, Self
 
 from pydantic import Field, model_validator
 
@@ -17,6 +17,10 @@ from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Posit
 from ridempc.units import CheckedModel
 
 __all__ = ["SegwayGains", "SegwayParameters", "SegwayReducedParameters"]
+
+# A signed coefficient of the identified model (SI units): the committed ones are below
+# 5e3; beyond 1e5 the fit has failed, whatever the board.
+Coefficient = Annotated[Real, Field(ge=-1e5, le=1e5)]
 
 
 class SegwayGains(CheckedModel):
@@ -66,11 +70,11 @@ class SegwayReducedParameters(CheckedModel):
     pitch_inertia: Positive
     c1: Positive
     c2: Positive
-    c3: Real
+    c3: Coefficient
     c4: Positive
-    c5: Real
-    c6: Real = 0.0
-    c7: Real = 0.0
+    c5: Coefficient
+    c6: Coefficient = 0.0
+    c7: Coefficient = 0.0
     mass: Positive
     k_turn: Positive
     tau_turn: Positive
