@@ -18,7 +18,18 @@ from pathlib import Path
 
 from ridempc.errors import ConfigError
 
-__all__ = ["readable_dir", "readable_file", "text_file", "writable_dir", "writable_file"]
+__all__ = [
+    "MAX_TEXT_BYTES",
+    "readable_dir",
+    "readable_file",
+    "text_file",
+    "writable_dir",
+    "writable_file",
+]
+
+# The largest text file read whole (a scenario, a parameter file, a manifest): the biggest
+# shipped one is under 100 kB; a larger file is a mistake, not a description.
+MAX_TEXT_BYTES: int = 10_000_000
 
 
 def _mode(path: Path, what: str) -> int | None:
@@ -31,6 +42,8 @@ def _mode(path: Path, what: str) -> int | None:
         raise ConfigError(f"{path}: {what}: a parent of it is a file, not a folder") from None
     except OSError as exc:
         raise ConfigError(f"{path}: {what}: cannot be reached ({exc.strerror})") from None
+    except ValueError:  # a NUL byte in the name
+        raise ConfigError(f"{path!r}: {what}: not a valid path") from None
 
 
 def readable_file(path: Path, what: str) -> Path:
@@ -46,6 +59,8 @@ def readable_file(path: Path, what: str) -> Path:
         raise ConfigError(f"{path}: {what} not found")
     if stat.S_ISDIR(mode):
         raise ConfigError(f"{path}: {what} is a folder, expected a file")
+    if not stat.S_ISREG(mode):  # a device, a pipe, a socket: reading it may never end
+        raise ConfigError(f"{path}: {what} is not a regular file")
     try:
         with open(path, "rb"):
             pass
@@ -61,6 +76,11 @@ def text_file(path: Path, what: str) -> str:
         ConfigError: As :func:`readable_file`, or the bytes are not UTF-8 (a binary file).
     """
     path = readable_file(path, what)
+    size = os.stat(path).st_size
+    if size > MAX_TEXT_BYTES:
+        raise ConfigError(
+            f"{path}: {what} is {size} bytes; allowed: at most {MAX_TEXT_BYTES} bytes of text"
+        )
     try:
         data = path.read_bytes()
     except OSError as exc:
@@ -127,6 +147,8 @@ def writable_file(path: Path, what: str) -> Path:
     mode = _mode(path, what)
     if mode is not None and stat.S_ISDIR(mode):
         raise ConfigError(f"{path}: {what} is a folder, expected a file")
+    if mode is not None and not stat.S_ISREG(mode):  # /dev/null would be replaced
+        raise ConfigError(f"{path}: {what} is not a regular file")
     parent = path.absolute().parent
     parent_mode = _mode(parent, what)
     if parent_mode is None:

@@ -191,7 +191,7 @@ def _bench(args: argparse.Namespace) -> int:
         writable_file(args.json, "--json file")
     if args.seconds is None:
         args.seconds = DEFAULT_SECONDS
-    pairs = [p.strip() for p in args.pairs.split(",")] if args.pairs else None
+    pairs = None if args.pairs is None else [p.strip() for p in args.pairs.split(",")]
     bench(
         pairs,
         seconds=args.seconds,

@@ -52,12 +52,14 @@ class ConfigError(RidempcError, ValueError):
     def from_validation(cls, path: Path | str, exc: ValidationError) -> ConfigError:
         """One line naming the file, the first bad field, its value and what is allowed."""
         first = exc.errors()[0]
-        where = ".".join(str(part) for part in first["loc"]) or "(top level)"
+        where = ".".join(str(part) for part in first["loc"])
+        field = f" field '{where}':" if where else ""
+        message = first["msg"].removeprefix("Value error, ")  # our own validators' words
         more = f" (and {exc.error_count() - 1} more)" if exc.error_count() > 1 else ""
         got = ""
         if first["type"] != "missing" and isinstance(first.get("input"), _SCALARS):
             got = f", got {_shown(first['input'])}"
-        return cls(f"{path}: field '{where}': {first['msg']}{got}{more}")
+        return cls(f"{path}:{field} {message}{got}{more}")
 
 
 class SimulationDiverged(RidempcError, RuntimeError):

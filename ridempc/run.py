@@ -124,6 +124,14 @@ def check_request(request: RideRequest) -> CheckedRide:
         if board is None:
             raise ConfigError(f"robot '{NO_ROBOT}' (a dead weight) needs a board to ride")
         dead_weight = load_robot(board.params.dead_weight_robot).mass
+    platforms = len(board.params.platform_sites) if board is not None else 0
+    offsets = len(scenario.platform_offsets)
+    if offsets and (platforms < 2 or offsets != platforms):  # only independent ones move
+        raise ConfigError(
+            f"scenario '{scenario.name}': field 'platform_offsets' has {offsets} entries; "
+            f"allowed: none, or one per independent platform (board '{board_name}' has "
+            f"{platforms if platforms > 1 else 'none'})"
+        )
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
     return CheckedRide(robot, board, board_name, scenario, controller, dead_weight, out)
@@ -143,10 +151,6 @@ def ride(request: RideRequest) -> dict[str, Any]:
     robot, board, board_name = checked.robot, checked.board, checked.board_name
     scenario, controller, dead_weight = checked.scenario, checked.controller, checked.dead_weight
 
-    out = checked.out
-    clear_run(out)
-    out.mkdir(parents=True, exist_ok=True)
-
     scene = build_scene(
         robot,
         request.physics_hz,
@@ -155,11 +159,29 @@ def ride(request: RideRequest) -> dict[str, Any]:
         foot_offset=scenario.foot_offset,
         platform_offsets=scenario.platform_offsets,
     )
+    height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
+    frame_callbacks: list[Any] = []
+
+    def on_frame(model: Any, data: Any) -> None:
+        for callback in frame_callbacks:
+            callback(model, data)
+
+    framed = request.video or request.viewer or request.snapshots > 0
+    simulation = Simulation(  # checks the scenario against the scene (its bodies)
+        scene,
+        controller,
+        scenario,
+        seed=request.seed,
+        ground_truth=request.ground_truth,
+        on_frame=on_frame if framed else None,
+    )
+
+    out = checked.out  # nothing is removed or written before this point
+    clear_run(out)
+    out.mkdir(parents=True, exist_ok=True)
     video = None
     viewer = None
     strip = None
-    frame_callbacks: list[Any] = []
-    height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
     if request.video:
         from ridempc.sim.video import VideoRecorder
 
@@ -188,18 +210,6 @@ def ride(request: RideRequest) -> dict[str, Any]:
         )
         frame_callbacks.append(strip)
 
-    def on_frame(model: Any, data: Any) -> None:
-        for callback in frame_callbacks:
-            callback(model, data)
-
-    simulation = Simulation(
-        scene,
-        controller,
-        scenario,
-        seed=request.seed,
-        ground_truth=request.ground_truth,
-        on_frame=on_frame if frame_callbacks else None,
-    )
     finished = False
     try:
         result = simulation.run()

@@ -3,7 +3,8 @@
 TOML and JSON hand pydantic Python values, and pydantic's lax mode would turn
 ``velocity = "1.0"`` or ``velocity = true`` into 1.0, and would take ``nan`` and ``inf``
 (both valid TOML). The types here refuse all of that: a :data:`Real` is an ``int`` or a
-``float`` (never a ``bool`` or a ``str``) and finite; a :data:`Count` is an ``int``. Tuple
+``float`` (never a ``bool`` or a ``str``) and finite; a :data:`Count` is an ``int``; a
+:data:`Flag` is a ``bool`` (never ``1`` or ``"yes"``). Tuple
 fields stay lax, so a TOML list still fills a tuple, but each element is checked by its own
 strict type.
 
@@ -27,6 +28,7 @@ __all__ = [
     "CheckedModel",
     "Count",
     "Duration",
+    "Flag",
     "Friction",
     "NonNegative",
     "NonNegativeCount",
@@ -65,6 +67,8 @@ Rate = Annotated[Real, Field(gt=0.0, le=MAX_RATE_HZ, description="[Hz]")]
 # Rubber on grip tape or asphalt stays below 2; 10 is beyond any real pair of surfaces.
 Friction = Annotated[Real, Field(gt=0.0, le=10.0, description="[-]")]
 Angle = Annotated[Real, Field(gt=0.0, lt=90.0, description="[deg], in (0, 90)")]
+Flag = Annotated[bool, Strict()]
+"""``true`` or ``false``, never a number or a string such as ``"yes"``."""
 
 CHECKED = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 

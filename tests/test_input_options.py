@@ -116,11 +116,11 @@ PATH_ARGUMENTS = [
 # The classes of bad path for each role of a path argument.
 CLASSES: dict[str, tuple[str, ...]] = {
     "file to read": ("file in place of a parent", "folder for a file", "missing", "not UTF-8",
-                     "unreadable"),
+                     "a pipe", "unreadable"),
     "folder to read": ("file in place of a parent", "file for a folder", "missing",
                        "unreadable"),
     "file to write": ("file in place of a parent", "folder for a file", "in a missing folder",
-                      "unwritable", "unwritable folder"),
+                      "a device", "unwritable", "unwritable folder"),
     "folder to write": ("file in place of a parent", "file for a folder", "unwritable",
                         "unwritable folder"),
 }  # fmt: skip
@@ -138,12 +138,15 @@ def _bad_path(tmp: Path, case: str) -> Path:
     locked.chmod(0)
     binary = tmp / "binary.toml"
     binary.write_bytes(b'name = "\xff\xfe"\n\x00\x01')
+    os.mkfifo(tmp / "pipe.toml")  # reading it would wait for a writer forever
     return {
         "file in place of a parent": a_file / "below.png",
         "folder for a file": a_folder,
         "file for a folder": a_file,
         "missing": tmp / "missing" / "nothing.toml",
         "not UTF-8": binary,
+        "a pipe": tmp / "pipe.toml",
+        "a device": Path("/dev/null"),  # replaced by a file if it were taken
         "in a missing folder": tmp / "missing" / "out.png",
         "unwritable": Path("/proc/ridempc-test/out.png"),  # refused to root too
         "unreadable": locked / "inside.toml",

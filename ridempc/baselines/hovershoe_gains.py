@@ -18,7 +18,7 @@ from pydantic import Field
 
 from ridempc.baselines.cassie_standing_gains import CassieStandingGains
 from ridempc.tomlfile import load_checked
-from ridempc.units import CheckedModel, NonNegative, Positive, Real
+from ridempc.units import CheckedModel, Flag, NonNegative, Positive, Real
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -63,7 +63,7 @@ class YAxisGains(_Frozen):
     )
     kp_hip_yaw: NonNegative = Field(description="K_p^q2: hip-yaw stiffness [N m/rad].")
     filter_hz: NonNegative = Field(description="Low-pass cut-off on the feet's y [Hz]; 0 = none.")
-    spread_by_hip_roll: bool = Field(
+    spread_by_hip_roll: Flag = Field(
         description="Move the standing hip-roll posture with the commanded y_offset change."
     )
 

@@ -39,7 +39,7 @@ from pydantic import Field, model_validator
 
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
-from ridempc.units import MAX_DURATION, CheckedModel, Duration, Real, Time
+from ridempc.units import MAX_DURATION, CheckedModel, Duration, Flag, Real, Time
 
 __all__ = [
     "Command",
@@ -139,7 +139,7 @@ class Disturbance(_Frozen):
     force: Vector3 = (0.0, 0.0, 0.0)  # world frame [N]
     torque: TorqueVector = (0.0, 0.0, 0.0)  # world frame [N m]
     duration: Annotated[Real, Field(gt=0.0, le=5.0)] = 0.1  # [s]; a longer one is a load
-    per_kg: bool = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
+    per_kg: Flag = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
 
 
 class ParameterChange(_Frozen):
@@ -188,6 +188,25 @@ class Scenario(_Frozen):
         times = [c.t for c in self.commands]
         if times != sorted(times):
             raise ValueError("commands must be in time order")
+        for i, wave in enumerate(self.waves):
+            if wave.stop <= wave.start:
+                raise ValueError(f"waves.{i}: stop ({wave.stop} s) must come after start")
+        return self
+
+    @model_validator(mode="after")
+    def _within_the_ride(self) -> Scenario:
+        """An event after the end would never happen: a mistake, not a no-op to ignore."""
+        times = [("metrics_start", self.metrics_start)]
+        times += [(f"commands.{i}.t", c.t) for i, c in enumerate(self.commands)]
+        times += [(f"waves.{i}.start", w.start) for i, w in enumerate(self.waves)]
+        times += [(f"disturbances.{i}.t", d.t) for i, d in enumerate(self.disturbances)]
+        if self.push_off is not None:
+            times.append(("push_off.judged_at", self.push_off.judged_at))
+        for where, t in times:
+            if t > self.duration or (where == "metrics_start" and t >= self.duration):
+                raise ValueError(
+                    f"{where} = {t} s is after the end of the ride (duration {self.duration} s)"
+                )
         return self
 
     def applies_to(self, robot: str, board: str) -> bool:
