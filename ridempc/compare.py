@@ -30,7 +30,7 @@ from ridempc.checks import writable_dir
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.io import atomic_savefig, atomic_write_json, atomic_write_text
 from ridempc.options import MAX_SEEDS
-from ridempc.results import clear_comparison
+from ridempc.results import clear_results
 from ridempc.run import RideRequest, check_request, ride
 
 __all__ = ["COMPARED_METRICS", "ComparisonRow", "compare", "comparison_table"]
@@ -179,7 +179,7 @@ def compare(
 
     Everything is checked before the first ride (the output folder, each controller on the
     pair, the scenario); then every file an earlier compare wrote in ``out`` is removed
-    (:func:`~ridempc.results.clear_comparison`), so the folder never mixes two comparisons.
+    (:func:`~ridempc.results.clear_results`), so the folder never mixes two comparisons.
 
     Raises:
         ConfigError: Seeds out of range, fewer than two controllers, a controller that does
@@ -211,7 +211,7 @@ def compare(
 
     for controller in controllers:  # every controller, pair and scenario before any ride
         check_request(request(controller, 0))
-    clear_comparison(out)
+    clear_results(out)
     rows = []
     for controller in controllers:
         summaries = []

@@ -1,10 +1,11 @@
 """The files ridempc writes into an ``--out`` folder, listed once, and their removal.
 
 A run that starts in a folder an earlier run wrote removes every file that earlier run
-wrote before it writes its own, so a folder never mixes two runs. It removes only the files
-listed here (and their temporary files, left by a run that was killed): anything else in
-the folder, such as a user's notes, is never touched, and a folder that is then empty is
-removed only where ridempc made it (a compare's per-controller and per-seed folders).
+wrote before it writes its own, so a folder never mixes two runs, whether the earlier one
+was a ``sim`` or a ``compare``. It removes only the files listed here (and their temporary
+files, left by a run that was killed): anything else in the folder, such as a user's notes,
+is never touched, and a folder that is then empty is removed only where ridempc made it (a
+compare's per-controller and per-seed folders).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-__all__ = ["COMPARISON_FILES", "RUN_FILES", "clear_comparison", "clear_run"]
+__all__ = ["COMPARISON_FILES", "RUN_FILES", "clear_results"]
 
 # What ``ridempc sim`` writes (summary.json first: its absence marks an unfinished run).
 RUN_FILES: tuple[str, ...] = ("summary.json", "log.npz", "plots.png", "video.mp4", "snapshots.png")
@@ -22,33 +23,28 @@ COMPARISON_FILES: tuple[str, ...] = ("comparison.json", "comparison.md", "overla
 _SEED_FOLDER = re.compile(r"^seed-[0-9]+$")
 
 
+def clear_results(folder: Path) -> None:
+    """Remove what an earlier ``ridempc sim`` or ``ridempc compare`` wrote in ``folder``:
+    its files and every ``<controller>/seed-<k>/`` run, whatever controllers and seeds it
+    had (nothing if the folder is new)."""
+    if not folder.is_dir():
+        return
+    _remove(folder, (*RUN_FILES, *COMPARISON_FILES))
+    for controller in [p for p in folder.iterdir() if p.is_dir() and not p.is_symlink()]:
+        seeds = [p for p in controller.iterdir() if p.is_dir() and _SEED_FOLDER.match(p.name)]
+        for seed in seeds:
+            _remove(seed, RUN_FILES)
+            _remove_if_empty(seed)
+        if seeds:
+            _remove_if_empty(controller)
+
+
 def _remove(folder: Path, names: tuple[str, ...]) -> None:
     for name in names:
         (folder / name).unlink(missing_ok=True)
         for stale in folder.glob(f".{name}.*"):  # its temporary files: ".<name>.<...>"
             if stale.is_file():
                 stale.unlink(missing_ok=True)
-
-
-def clear_run(folder: Path) -> None:
-    """Remove what an earlier ``ridempc sim`` wrote in ``folder`` (nothing if it is new)."""
-    if folder.is_dir():
-        _remove(folder, RUN_FILES)
-
-
-def clear_comparison(folder: Path) -> None:
-    """Remove what an earlier ``ridempc compare`` wrote in ``folder``: its table, its plot
-    and every ``<controller>/seed-<k>/`` run, whatever controllers and seeds it had."""
-    if not folder.is_dir():
-        return
-    _remove(folder, COMPARISON_FILES)
-    for controller in [p for p in folder.iterdir() if p.is_dir() and not p.is_symlink()]:
-        seeds = [p for p in controller.iterdir() if p.is_dir() and _SEED_FOLDER.match(p.name)]
-        for seed in seeds:
-            clear_run(seed)
-            _remove_if_empty(seed)
-        if seeds:
-            _remove_if_empty(controller)
 
 
 def _remove_if_empty(folder: Path) -> None:

@@ -19,7 +19,7 @@ from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
 from ridempc.errors import ConfigError
 from ridempc.io import atomic_write_json, atomic_write_npz
-from ridempc.results import clear_run
+from ridempc.results import clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -140,8 +140,9 @@ def check_request(request: RideRequest) -> CheckedRide:
 def ride(request: RideRequest) -> dict[str, Any]:
     """Run one ride and write its results; returns the summary.
 
-    Every file an earlier run wrote in the output folder (:data:`~ridempc.results.RUN_FILES`)
-    is removed before the ride starts; nothing else there is touched.
+    Every file an earlier ``sim`` or ``compare`` wrote in the output folder is removed once
+    everything is checked, before the ride starts
+    (:func:`~ridempc.results.clear_results`); nothing else there is touched.
 
     Raises:
         UnknownNameError: A name that does not exist (before anything is written).
@@ -177,7 +178,7 @@ def ride(request: RideRequest) -> dict[str, Any]:
     )
 
     out = checked.out  # nothing is removed or written before this point
-    clear_run(out)
+    clear_results(out)
     out.mkdir(parents=True, exist_ok=True)
     video = None
     viewer = None

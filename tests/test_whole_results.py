@@ -129,3 +129,14 @@ def test_a_failed_write_leaves_no_temporary_file(tmp_path: Path) -> None:
     with pytest.raises(ValueError):
         atomic_savefig(BrokenFigure(), tmp_path / "plots.png", dpi=90)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_sim_and_compare_never_share_a_folder_s_results(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "shared"
+    assert main([*SIM, "--out", str(out)]) == 0
+    argv = [*COMPARE, "--controllers", "stand,pd", "--duration", "0.2", "--out", str(out)]
+    assert main(argv) == 0
+    assert not (out / "summary.json").exists() and not (out / "log.npz").exists()
+    assert main([*SIM, "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert sorted(p.name for p in out.iterdir()) == ["log.npz", "summary.json"]
