@@ -25,6 +25,7 @@ EXIT_FAILED = 1
 
 
 DURATION_HELP = f"override duration [s], at most {MAX_DURATION:g}"
+OUT_HELP = "output folder; the files an earlier sim or compare wrote there are replaced"
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -39,7 +40,7 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--controller", default="stand", help="controller name (default: stand)")
     sim.add_argument("--scenario", default="stand-still", help="scenario name or .toml file")
     sim.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
-    sim.add_argument("--out", type=Path, required=True, help="output folder")
+    sim.add_argument("--out", type=Path, required=True, help=OUT_HELP)
     sim.add_argument(
         "--seed",
         type=options.bounded_int(0, options.MAX_SEED),
@@ -81,7 +82,7 @@ def _parser() -> argparse.ArgumentParser:
         "--controllers", default="pd,mpc", help="comma-separated controllers (default: pd,mpc)"
     )
     compare.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
-    compare.add_argument("--out", type=Path, required=True, help="output folder")
+    compare.add_argument("--out", type=Path, required=True, help=OUT_HELP)
 
     bench = commands.add_parser(
         "bench", help="MPC and WBC solve times on recorded problems, against other QP solvers"

@@ -13,7 +13,7 @@ import sys
 from collections.abc import Callable
 from typing import NoReturn
 
-from ridempc.units import MAX_DURATION
+from ridempc.units import MAX_DURATION, MIN_DURATION
 
 __all__ = [
     "MAX_BENCH_SECONDS",
@@ -65,23 +65,24 @@ def _number(text: str, allowed: str) -> float:
     return value
 
 
-def _seconds(upper: float) -> Callable[[str], float]:
-    allowed = f"allowed: seconds in (0, {upper:g}]"
+def _seconds(lower: float, upper: float) -> Callable[[str], float]:
+    allowed = f"allowed: seconds in [{lower:g}, {upper:g}]"
 
     def parse(text: str) -> float:
         value = _number(text, allowed)
-        if not 0.0 < value <= upper:
+        if not lower <= value <= upper:
             raise argparse.ArgumentTypeError(f"{text} is out of range; {allowed}")
         return value
 
     return parse
 
 
-duration = _seconds(MAX_DURATION)
-"""``--duration``: a ride's length [s], in (0, :data:`~ridempc.units.MAX_DURATION`]: the same
-bound as a scenario file's ``duration``."""
-positive_seconds = _seconds(MAX_BENCH_SECONDS)
-"""``--seconds`` of the bench [s], in (0, :data:`MAX_BENCH_SECONDS`]."""
+duration = _seconds(MIN_DURATION, MAX_DURATION)
+"""``--duration``: a ride's length [s], in [:data:`~ridempc.units.MIN_DURATION`,
+:data:`~ridempc.units.MAX_DURATION`]: the same bounds as a scenario file's ``duration``."""
+positive_seconds = _seconds(MIN_DURATION, MAX_BENCH_SECONDS)
+"""``--seconds`` of the bench [s], in [:data:`~ridempc.units.MIN_DURATION`,
+:data:`MAX_BENCH_SECONDS`]."""
 
 
 def bounded_int(lower: int, upper: int) -> Callable[[str], int]:

@@ -26,7 +26,7 @@ from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
-from ridempc.units import MAX_DURATION
+from ridempc.units import MAX_DURATION, MIN_DURATION
 
 if TYPE_CHECKING:
     from ridempc.boards.board import Board
@@ -106,9 +106,10 @@ def check_request(request: RideRequest) -> CheckedRide:
             the robot-board pair.
     """
     out = writable_dir(Path(request.out), "--out folder")
-    if request.duration is not None and not 0.0 < request.duration <= MAX_DURATION:
+    if request.duration is not None and not MIN_DURATION <= request.duration <= MAX_DURATION:
         raise ConfigError(  # NaN fails the comparison too
-            f"--duration {request.duration}: allowed: seconds in (0, {MAX_DURATION:g}]"
+            f"--duration {request.duration}: allowed: seconds in "
+            f"[{MIN_DURATION:g}, {MAX_DURATION:g}]"
         )
     robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
     board = load_board(request.board)

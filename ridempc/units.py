@@ -24,6 +24,7 @@ __all__ = [
     "CHECKED",
     "MAX_DURATION",
     "MAX_RATE_HZ",
+    "MIN_DURATION",
     "Angle",
     "CheckedModel",
     "Count",
@@ -36,12 +37,15 @@ __all__ = [
     "PositiveCount",
     "Rate",
     "Real",
+    "RideDuration",
     "Time",
 ]
 
 # The longest ride, scenario or ``--duration`` [s]: an hour is far beyond any manoeuvre and
 # keeps a ride's log (hundreds of channels at 1 kHz) within memory.
 MAX_DURATION: float = 3600.0
+# The shortest ride [s]: one sample of the 100 Hz log; a shorter one records nothing.
+MIN_DURATION: float = 0.01
 # The fastest loop any file may ask for [Hz]: a physics step below 0.1 ms buys nothing.
 MAX_RATE_HZ: float = 10_000.0
 
@@ -63,6 +67,8 @@ Time = Annotated[Real, Field(ge=0.0, le=MAX_DURATION, description="[s]")]
 """An instant of a ride [s], from its start to the longest ride."""
 Duration = Annotated[Real, Field(gt=0.0, le=MAX_DURATION, description="[s]")]
 """A positive span of time [s], at most the longest ride."""
+RideDuration = Annotated[Real, Field(ge=MIN_DURATION, le=MAX_DURATION, description="[s]")]
+"""The length of a ride [s], from one log sample to the longest ride."""
 Rate = Annotated[Real, Field(gt=0.0, le=MAX_RATE_HZ, description="[Hz]")]
 # Rubber on grip tape or asphalt stays below 2; 10 is beyond any real pair of surfaces.
 Friction = Annotated[Real, Field(gt=0.0, le=10.0, description="[-]")]

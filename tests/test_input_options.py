@@ -65,7 +65,7 @@ NOT_NUMBERS = ("x", "nan", "NaN", "inf", "-inf", "1e999", "")
 
 # (command, option, extra arguments, bad values of its range)
 NUMERIC_OPTIONS = [
-    (SIM, "--duration", ["--out", "{out}"], ["0", "-1", str(MAX_DURATION * 1.01)]),
+    (SIM, "--duration", ["--out", "{out}"], ["0", "-1", "1e-9", str(MAX_DURATION * 1.01)]),
     (SIM, "--seed", ["--out", "{out}"], ["-1", str(MAX_SEED + 1), "1.5", "true"]),
     (SIM, "--snapshots", ["--out", "{out}"], ["-1", str(MAX_SNAPSHOTS + 1), "2.0"]),
     (COMPARE, "--seeds", ["--out", "{out}"], ["0", "-3", str(MAX_SEEDS + 1), "1.5"]),

@@ -39,7 +39,7 @@ from pydantic import Field, model_validator
 
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
-from ridempc.units import MAX_DURATION, CheckedModel, Duration, Flag, Real, Time
+from ridempc.units import MAX_DURATION, CheckedModel, Duration, Flag, Real, RideDuration, Time
 
 __all__ = [
     "Command",
@@ -170,7 +170,7 @@ class Scenario(_Frozen):
 
     name: str = Field(pattern=r"^[a-z0-9][a-z0-9._-]*$")
     description: str = ""
-    duration: Duration
+    duration: RideDuration
     robots: tuple[str, ...] = ()  # robots it applies to; empty means any
     boards: tuple[str, ...] = ()  # boards it applies to; empty means any
     metrics_start: Time = 0.0  # tracking errors are measured from this time on [s]
