@@ -142,8 +142,12 @@ def read_manifest(folder: Path) -> Manifest:
     if not path.exists() and not path.is_symlink():
         raise ConfigError(f"{path}: no motion library here (manifest.json not found)")
     text = text_file(path, "motion-library manifest")
+
+    def refuse(constant: str) -> None:  # JSON has no NaN or Infinity; Python's reader takes them
+        raise ConfigError(f"{path}: holds {constant}; allowed: finite numbers only")
+
     try:
-        raw = json.loads(text)
+        raw = json.loads(text, parse_constant=refuse)
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{path}: not valid JSON ({exc})") from exc
     try:
