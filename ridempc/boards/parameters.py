@@ -11,7 +11,7 @@ with its own figures (wheel radius, rake angles, ...), every one checked to be p
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 from pydantic import Field
 
@@ -21,13 +21,34 @@ from ridempc.units import Angle, CheckedModel, Friction, NonNegative, Positive, 
 __all__ = [
     "Angle",
     "BoardParameters",
+    "Clearance",
     "Friction",
+    "GroundSpeed",
+    "Length",
+    "Mass",
+    "MotorSpeed",
     "NonNegative",
     "Positive",
     "Real",
+    "Torque",
     "read_board_toml",
     "validate_board_parameters",
 ]
+
+
+# Upper bounds of a board's figures: each well beyond any rideable board, so that a value
+# past one is a slip of units (millimetres for metres, grams for kilograms), not a board.
+# A board part heavier than 200 kg (a whole Segway miniPro is 13 kg).
+Mass = Annotated[Positive, Field(le=200.0, description="[kg]")]
+# A board dimension beyond 2 m (a longboard's deck is 1.2 m).
+Length = Annotated[Positive, Field(le=2.0, description="[m]")]
+Clearance = Annotated[NonNegative, Field(le=2.0, description="[m]")]
+# A wheel motor above 500 N m (hub motors of personal transporters give tens of N m).
+Torque = Annotated[Positive, Field(le=500.0, description="[N m]")]
+# A ground speed above 20 m/s (personal transporters stop near 6 m/s).
+GroundSpeed = Annotated[Positive, Field(le=20.0, description="[m/s]")]
+# A motor turning faster than 1000 rad/s (10,000 rpm) at the wheel.
+MotorSpeed = Annotated[Positive, Field(le=1000.0, description="[rad/s]")]
 
 
 class BoardParameters(CheckedModel):

@@ -13,7 +13,17 @@ from typing import Literal
 
 from pydantic import ValidationInfo, field_validator
 
-from ridempc.boards.parameters import BoardParameters, Friction, NonNegative, Positive
+from ridempc.boards.parameters import (
+    BoardParameters,
+    Friction,
+    GroundSpeed,
+    Length,
+    Mass,
+    MotorSpeed,
+    NonNegative,
+    Positive,
+    Torque,
+)
 from ridempc.units import CheckedModel
 
 __all__ = ["HovershoesParameters", "HovershoesReducedParameters"]
@@ -67,19 +77,19 @@ class HovershoesParameters(BoardParameters):
     """
 
     kind: Literal["hovershoes"]
-    shoe_mass: Positive
-    wheel_mass: Positive
-    wheel_radius: Positive
-    wheel_width: Positive
-    platform_length: Positive
-    platform_width: Positive
-    platform_thickness: Positive
-    platform_height: Positive
-    shoe_spacing: Positive
+    shoe_mass: Mass
+    wheel_mass: Mass
+    wheel_radius: Length
+    wheel_width: Length
+    platform_length: Length
+    platform_width: Length
+    platform_thickness: Length
+    platform_height: Length
+    shoe_spacing: Length
     platform_friction: Friction
-    motor_torque_limit: Positive
-    motor_speed_limit: Positive
-    speed_limit: Positive
+    motor_torque_limit: Torque
+    motor_speed_limit: MotorSpeed
+    speed_limit: GroundSpeed
     pitch_kp: Positive
     pitch_kd: NonNegative
     tilt_back_gain: NonNegative

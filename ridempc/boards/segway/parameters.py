@@ -13,7 +13,18 @@ from typing import Annotated, Literal, Self
 
 from pydantic import Field, model_validator
 
-from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive, Real
+from ridempc.boards.parameters import (
+    Angle,
+    BoardParameters,
+    Clearance,
+    GroundSpeed,
+    Length,
+    Mass,
+    NonNegative,
+    Positive,
+    Real,
+    Torque,
+)
 from ridempc.units import CheckedModel
 
 __all__ = ["SegwayGains", "SegwayParameters", "SegwayReducedParameters"]
@@ -112,27 +123,27 @@ class SegwayParameters(BoardParameters):
     """
 
     kind: Literal["segway"]
-    wheel_radius: Positive
-    wheel_width: Positive
-    wheel_mass: Positive
-    track_width: Positive
-    chassis_mass: Positive
-    platform_length: Positive
-    platform_width: Positive
-    platform_thickness: Positive
-    platform_height: Positive
-    knee_bar_mass: Positive
-    knee_bar_height: Positive
-    knee_bar_radius: Positive
-    knee_bar_contact_from: NonNegative
-    knee_pad_width: Positive
-    knee_pad_depth: Positive
-    knee_pad_height: Positive
+    wheel_radius: Length
+    wheel_width: Length
+    wheel_mass: Mass
+    track_width: Length
+    chassis_mass: Mass
+    platform_length: Length
+    platform_width: Length
+    platform_thickness: Length
+    platform_height: Length
+    knee_bar_mass: Mass
+    knee_bar_height: Length
+    knee_bar_radius: Length
+    knee_bar_contact_from: Clearance
+    knee_pad_width: Length
+    knee_pad_depth: Length
+    knee_pad_height: Length
     knee_bar_stiffness: Positive
     knee_bar_damping: NonNegative
     knee_bar_range: Angle
-    motor_torque_limit: Positive
-    top_speed: Positive
+    motor_torque_limit: Torque
+    top_speed: GroundSpeed
     gains: SegwayGains
     reduced: SegwayReducedParameters | None = Field(default=None)
 

@@ -17,7 +17,15 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive, Real
+from ridempc.boards.parameters import (
+    Angle,
+    BoardParameters,
+    Length,
+    Mass,
+    NonNegative,
+    Positive,
+    Real,
+)
 from ridempc.units import CheckedModel
 
 __all__ = ["SkateboardParameters", "SkateboardReducedParameters"]
@@ -68,17 +76,17 @@ class SkateboardParameters(BoardParameters):
     """
 
     kind: Literal["skateboard"]
-    deck_length: Positive
-    deck_width: Positive
-    deck_thickness: Positive
-    deck_mass: Positive
-    height: Positive
-    wheelbase: Positive
-    truck_width: Positive
-    truck_mass: Positive
-    wheel_radius: Positive
-    wheel_width: Positive
-    wheel_mass: Positive
+    deck_length: Length
+    deck_width: Length
+    deck_thickness: Length
+    deck_mass: Mass
+    height: Length
+    wheelbase: Length
+    truck_width: Length
+    truck_mass: Mass
+    wheel_radius: Length
+    wheel_width: Length
+    wheel_mass: Mass
     rake_front: Angle
     rake_rear: Angle
     bushing_stiffness: Positive
