@@ -55,7 +55,12 @@ def _plain_int(value: Any) -> Any:
     return int(value) if isinstance(value, np.integer) else value
 
 
-Real = Annotated[float, Strict(), AllowInfNan(False)]
+def _plain_number(value: Any) -> Any:
+    """NumPy numbers (a fit's or a solver's figures) as Python ones; anything else unchanged."""
+    return value.item() if isinstance(value, np.integer | np.floating) else value
+
+
+Real = Annotated[float, Strict(), AllowInfNan(False), BeforeValidator(_plain_number)]
 """A finite number given as an int or a float, never as a bool or a string."""
 Positive = Annotated[Real, Field(gt=0.0)]
 NonNegative = Annotated[Real, Field(ge=0.0)]
