@@ -22,8 +22,6 @@ from ridempc.units import MAX_DURATION
 __all__ = ["main"]
 
 EXIT_FAILED = 1
-
-
 DURATION_HELP = f"override duration [s], at most {MAX_DURATION:g}"
 OUT_HELP = "output folder; the files an earlier sim or compare wrote there are replaced"
 

@@ -110,10 +110,10 @@ def library_show(
             f"{folder / 'manifest.json'}: holds {manifest.robot}-{manifest.board}, "
             f"not {robot}-{board}"
         )
+    chosen = None if entry is None else _find(entries, entry, folder)  # before any output
     print(f"{pair.name}: {len(entries)} entries in {folder} (all hashes and arrays verified)")
     print(table([e.record for e in entries]))
-    if entry is not None:
-        chosen = _find(entries, entry, folder)
+    if chosen is not None:
         r = chosen.record
         print(
             f"{r.name}: {r.n_intervals} intervals of {r.dt} s; drift: local {r.drift.local:.1e}, "
