@@ -165,6 +165,10 @@ def compare(
 ) -> list[ComparisonRow]:
     """Ride ``scenario`` with each controller for seeds ``0 .. seeds-1`` and compare.
 
+    Everything is checked before the first ride (the output folder, each controller on the
+    pair, the scenario on its scene); then every file an earlier run wrote in ``out`` is
+    removed (:func:`~ridempc.results.clear_results`), so the folder never mixes two runs.
+
     Args:
         robot: Robot name.
         board: Board name.
@@ -176,10 +180,6 @@ def compare(
 
     Returns:
         One row per controller, in the given order.
-
-    Everything is checked before the first ride (the output folder, each controller on the
-    pair, the scenario); then every file an earlier compare wrote in ``out`` is removed
-    (:func:`~ridempc.results.clear_results`), so the folder never mixes two comparisons.
 
     Raises:
         ConfigError: Seeds out of range, fewer than two controllers, a controller that does

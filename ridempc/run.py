@@ -10,6 +10,7 @@ interrupted run never leaves a summary that looks complete.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -29,9 +30,9 @@ from ridempc.sim.simulation import Simulation
 from ridempc.units import MAX_DURATION, MIN_DURATION
 
 if TYPE_CHECKING:
-    from ridempc.boards.board import Board
     from ridempc.controllers.base import Controller
     from ridempc.robots.robot import Robot
+    from ridempc.sim.scene import Scene
 
 __all__ = ["CheckedRide", "RideRequest", "check_request", "ride"]
 
@@ -75,35 +76,45 @@ class RideRequest:
 
 @dataclass(frozen=True)
 class CheckedRide:
-    """A request with every name, file and number resolved and checked; nothing written yet.
+    """A request with every name, file and number resolved and checked, its scene built and
+    its simulation set up; nothing written yet.
 
     Attributes:
         robot: The robot, or None for a dead weight.
-        board: The board, or None for flat ground.
         board_name: The board's name (``none`` for flat ground).
         scenario: The scenario, with the request's duration.
         controller: The controller, or None for a dead weight.
-        dead_weight: Mass of the dead weight [kg], or None with a robot.
+        scene: The built scene.
+        simulation: The simulation, ready to run.
+        rider_height: Height of the rider's base at the start [m] (frames the cameras).
+        frame_callbacks: Called with (model, data) at the frame rate, when the request
+            renders or views anything; :func:`ride` adds its recorders here.
         out: The output folder (writable, or creatable).
     """
 
     robot: Robot | None
-    board: Board | None
     board_name: str
     scenario: Scenario
     controller: Controller | None
-    dead_weight: float | None
+    scene: Scene
+    simulation: Simulation
+    rider_height: float
+    frame_callbacks: list[Callable[[Any, Any], None]]
     out: Path
 
 
 def check_request(request: RideRequest) -> CheckedRide:
     """Check everything a ride needs, before anything is written or simulated.
 
+    The output folder first (in the command's first second), then the numbers, the names,
+    the files, and last what only the built scene can tell (a disturbance's body, the
+    rates): every bad input is found before an earlier run's results are touched.
+
     Raises:
         UnknownNameError: A name that does not exist.
         ConfigError: An output folder that cannot be written, a malformed scenario or
             parameter file, a duration out of range, or a scenario that does not apply to
-            the robot-board pair.
+            the robot-board pair or its scene.
     """
     out = writable_dir(Path(request.out), "--out folder")
     if request.duration is not None and not MIN_DURATION <= request.duration <= MAX_DURATION:
@@ -135,23 +146,6 @@ def check_request(request: RideRequest) -> CheckedRide:
         )
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
-    return CheckedRide(robot, board, board_name, scenario, controller, dead_weight, out)
-
-
-def ride(request: RideRequest) -> dict[str, Any]:
-    """Run one ride and write its results; returns the summary.
-
-    Every file an earlier ``sim`` or ``compare`` wrote in the output folder is removed once
-    everything is checked, before the ride starts
-    (:func:`~ridempc.results.clear_results`); nothing else there is touched.
-
-    Raises:
-        UnknownNameError: A name that does not exist (before anything is written).
-        ConfigError: See :func:`check_request` (before anything is written).
-    """
-    checked = check_request(request)
-    robot, board, board_name = checked.robot, checked.board, checked.board_name
-    scenario, controller, dead_weight = checked.scenario, checked.controller, checked.dead_weight
 
     scene = build_scene(
         robot,
@@ -161,8 +155,8 @@ def ride(request: RideRequest) -> dict[str, Any]:
         foot_offset=scenario.foot_offset,
         platform_offsets=scenario.platform_offsets,
     )
-    height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
-    frame_callbacks: list[Any] = []
+    height = float(scene.data.xpos[scene.base_body, 2])
+    frame_callbacks: list[Callable[[Any, Any], None]] = []
 
     def on_frame(model: Any, data: Any) -> None:
         for callback in frame_callbacks:
@@ -177,6 +171,27 @@ def ride(request: RideRequest) -> dict[str, Any]:
         ground_truth=request.ground_truth,
         on_frame=on_frame if framed else None,
     )
+    return CheckedRide(
+        robot, board_name, scenario, controller, scene, simulation, height, frame_callbacks, out
+    )
+
+
+def ride(request: RideRequest) -> dict[str, Any]:
+    """Run one ride and write its results; returns the summary.
+
+    Every file an earlier ``sim`` or ``compare`` wrote in the output folder is removed once
+    everything is checked (:func:`check_request`), before the ride starts
+    (:func:`~ridempc.results.clear_results`); nothing else there is touched.
+
+    Raises:
+        UnknownNameError: A name that does not exist (before anything is written).
+        ConfigError: See :func:`check_request` (before anything is written).
+    """
+    checked = check_request(request)
+    robot, board_name, scenario = checked.robot, checked.board_name, checked.scenario
+    controller, scene, simulation = checked.controller, checked.scene, checked.simulation
+    height = checked.rider_height  # frame the rider by its height
+    frame_callbacks = checked.frame_callbacks
 
     out = checked.out  # nothing is removed or written before this point
     clear_results(out)

@@ -140,3 +140,17 @@ def test_sim_and_compare_never_share_a_folder_s_results(capsys, tmp_path: Path) 
     assert main([*SIM, "--out", str(out)]) == 0
     capsys.readouterr()
     assert sorted(p.name for p in out.iterdir()) == ["log.npz", "summary.json"]
+
+
+def test_bad_input_found_on_the_scene_keeps_the_earlier_results(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "cmp"
+    argv = [*COMPARE, "--controllers", "stand,pd", "--duration", "0.2", "--out", str(out)]
+    assert main(argv) == 0
+    before = sorted(out.rglob("*"))
+    scenario = tmp_path / "kick.toml"
+    scenario.write_text('name = "kick"\nduration = 1.0\n[[disturbances]]\nt = 0.5\nbody = "tail"\n')
+    bad = [a if a != "stand-still" else str(scenario) for a in argv]
+    code = main(bad)
+    err = capsys.readouterr().err
+    assert code == 2 and "'tail'" in err and len(err.strip().splitlines()) == 1
+    assert sorted(out.rglob("*")) == before
