@@ -11,7 +11,6 @@ import argparse
 import os
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 
 from ridempc import options
 from ridempc.checks import writable_file
@@ -38,7 +37,7 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--controller", default="stand", help="controller name (default: stand)")
     sim.add_argument("--scenario", default="stand-still", help="scenario name or .toml file")
     sim.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
-    sim.add_argument("--out", type=Path, required=True, help=OUT_HELP)
+    sim.add_argument("--out", type=options.path, required=True, help=OUT_HELP)
     sim.add_argument(
         "--seed",
         type=options.bounded_int(0, options.MAX_SEED),
@@ -80,7 +79,7 @@ def _parser() -> argparse.ArgumentParser:
         "--controllers", default="pd,mpc", help="comma-separated controllers (default: pd,mpc)"
     )
     compare.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
-    compare.add_argument("--out", type=Path, required=True, help=OUT_HELP)
+    compare.add_argument("--out", type=options.path, required=True, help=OUT_HELP)
 
     bench = commands.add_parser(
         "bench", help="MPC and WBC solve times on recorded problems, against other QP solvers"
@@ -106,7 +105,9 @@ def _parser() -> argparse.ArgumentParser:
         default="osqp",
         help="the whole-body QP's solver in the ride and its timing: osqp (default) or daqp",
     )
-    bench.add_argument("--json", type=Path, default=None, help="also write the results here")
+    bench.add_argument(
+        "--json", type=options.path, default=None, help="also write the results here"
+    )
 
     board = commands.add_parser("board", help="board tools")
     board_commands = board.add_subparsers(dest="board_command", required=True)
@@ -114,7 +115,9 @@ def _parser() -> argparse.ArgumentParser:
         "identify", help="identify a board's reduced model from simulated experiments"
     )
     identify.add_argument("--board", required=True, help="board name")
-    identify.add_argument("--json", type=Path, default=None, help="also write the result here")
+    identify.add_argument(
+        "--json", type=options.path, default=None, help="also write the result here"
+    )
 
     library = commands.add_parser("library", help="motion libraries (trajectory optimisation)")
     library_commands = library.add_subparsers(dest="library_command", required=True)
@@ -130,12 +133,12 @@ def _parser() -> argparse.ArgumentParser:
         default=1,
         help=f"worker processes, 1 to {options.MAX_JOBS} (default: 1)",
     )
-    build.add_argument("--out", type=Path, default=None, help="library folder")
-    show.add_argument("--dir", type=Path, default=None, help="library folder")
+    build.add_argument("--out", type=options.path, default=None, help="library folder")
+    show.add_argument("--dir", type=options.path, default=None, help="library folder")
     show.add_argument(
         "--entry", type=options.entry_key, default=None, help="entry name or target, e.g. 0.5"
     )
-    show.add_argument("--plot", type=Path, default=None, help="write a PNG of the entry")
+    show.add_argument("--plot", type=options.path, default=None, help="write a PNG of the entry")
     return parser
 
 

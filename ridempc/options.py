@@ -11,6 +11,7 @@ import argparse
 import math
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import NoReturn
 
 from ridempc.units import MAX_DURATION, MIN_DURATION
@@ -25,6 +26,7 @@ __all__ = [
     "bounded_int",
     "duration",
     "entry_key",
+    "path",
     "positive_seconds",
 ]
 
@@ -113,3 +115,12 @@ def entry_key(text: str) -> str:
             f"'{text}' is not a finite number; allowed: an entry name or its target"
         )
     return text
+
+
+def path(text: str) -> Path:
+    """A path argument: not empty (``Path("")`` would silently be the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; allowed: a file or folder name")
+    if "\0" in text:
+        raise argparse.ArgumentTypeError(f"{text!r} holds a NUL byte; allowed: a path")
+    return Path(text)

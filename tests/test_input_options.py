@@ -181,6 +181,16 @@ def test_bad_paths_are_refused_before_any_work(
     assert sorted(tmp_path.rglob("*")) == before  # nothing written
 
 
+@pytest.mark.parametrize(
+    ("command", "option", "extra"),
+    [a[:2] + (a[3],) for a in PATH_ARGUMENTS if a[1] != "--scenario"],  # a name or a path
+)
+def test_an_empty_path_is_refused(capsys, tmp_path: Path, command, option, extra) -> None:
+    extra = [a.replace("{tmp}", str(tmp_path)) for a in extra]
+    line = _refused(capsys, [*command, option, "", *extra])
+    assert option in line
+
+
 def test_a_scenario_path_that_does_not_exist_says_file_not_found(capsys, tmp_path) -> None:
     for name in ("nope.toml", str(tmp_path / "nope")):
         line = _refused(capsys, [*SIM, "--scenario", name, "--out", str(tmp_path / "o")])
