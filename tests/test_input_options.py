@@ -192,7 +192,7 @@ def test_an_empty_path_is_refused(capsys, tmp_path: Path, command, option, extra
 
 
 def test_a_scenario_path_that_does_not_exist_says_file_not_found(capsys, tmp_path) -> None:
-    for name in ("nope.toml", str(tmp_path / "nope")):
+    for name in ("nope.toml", "NOPE.TOML", str(tmp_path / "nope")):
         line = _refused(capsys, [*SIM, "--scenario", name, "--out", str(tmp_path / "o")])
         assert "not found" in line and "unknown scenario" not in line
 
