@@ -38,8 +38,8 @@ __all__ = ["GroundTruth", "ImuReading", "SensorNoise", "SensorPacket", "SensorSu
 Array = NDArray[np.float64]
 
 
-# Upper bounds of the noise figures: ten times the worst consumer-grade sensor; a value above
-# them is a typo (a degree for a radian), not a noisier sensor.
+# Upper bounds of the noise figures: at them a reading says nothing (a 0.5 rad tilt, a 1 m
+# position error), so a larger figure is a slip of units (degrees for radians), not a sensor.
 _Std = Annotated[Real, Field(ge=0.0)]
 
 
