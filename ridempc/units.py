@@ -50,13 +50,8 @@ MIN_DURATION: float = 0.01
 MAX_RATE_HZ: float = 10_000.0
 
 
-def _plain_int(value: Any) -> Any:
-    """NumPy integers (a library build's counters) as Python ints; anything else unchanged."""
-    return int(value) if isinstance(value, np.integer) else value
-
-
 def _plain_number(value: Any) -> Any:
-    """NumPy numbers (a fit's or a solver's figures) as Python ones; anything else unchanged."""
+    """NumPy numbers (a fit's figures, a build's counters) as Python ones; else unchanged."""
     return value.item() if isinstance(value, np.integer | np.floating) else value
 
 
@@ -64,7 +59,7 @@ Real = Annotated[float, Strict(), AllowInfNan(False), BeforeValidator(_plain_num
 """A finite number given as an int or a float, never as a bool or a string."""
 Positive = Annotated[Real, Field(gt=0.0)]
 NonNegative = Annotated[Real, Field(ge=0.0)]
-Count = Annotated[int, Strict(), BeforeValidator(_plain_int)]
+Count = Annotated[int, Strict(), BeforeValidator(_plain_number)]
 """An integer given as an int (a float, a bool or a string is refused)."""
 PositiveCount = Annotated[Count, Field(gt=0)]
 NonNegativeCount = Annotated[Count, Field(ge=0)]
