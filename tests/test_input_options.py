@@ -236,3 +236,13 @@ def test_the_installed_command_prints_one_line_and_no_traceback(tmp_path: Path, 
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("ridempc: error: "), done.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_a_file_too_large_to_be_a_description_is_refused(capsys, tmp_path, monkeypatch) -> None:
+    import ridempc.checks
+
+    monkeypatch.setattr(ridempc.checks, "MAX_TEXT_BYTES", 16)
+    scenario = tmp_path / "big.toml"
+    scenario.write_text('name = "big"\nduration = 1.0\n')
+    line = _refused(capsys, [*SIM, "--scenario", str(scenario), "--out", str(tmp_path / "o")])
+    assert "at most 16 bytes" in line
