@@ -246,3 +246,33 @@ def test_a_file_too_large_to_be_a_description_is_refused(capsys, tmp_path, monke
     scenario.write_text('name = "big"\nduration = 1.0\n')
     line = _refused(capsys, [*SIM, "--scenario", str(scenario), "--out", str(tmp_path / "o")])
     assert "at most 16 bytes" in line
+
+
+@pytest.mark.parametrize("damage", ["not UTF-8", "a folder", "not TOML", "missing MJCF"])
+@pytest.mark.parametrize("which", ["robots/cassie/robot.toml", "boards/segway/board.toml"])
+def test_a_damaged_robot_or_board_file_is_one_line(
+    capsys, tmp_path: Path, monkeypatch, which, damage
+) -> None:
+    """The robot and board descriptions a user edits, read through the same checks."""
+    import shutil
+
+    import ridempc.paths
+
+    root = tmp_path / "data"
+    for folder in ("robots", "boards"):
+        shutil.copytree(ridempc.paths.data_root() / folder, root / folder)
+    monkeypatch.setattr(ridempc.paths, "data_root", lambda: root)
+    target = root / which
+    if damage == "not UTF-8":
+        target.write_bytes(b"\xff\xfe\x00binary")
+    elif damage == "a folder":
+        target.unlink()
+        target.mkdir()
+    elif damage == "not TOML":
+        target.write_text("name = \n")
+    else:
+        (root / "robots" / "cassie" / "cassie.xml").unlink()
+    argv = ["sim", "--robot", "cassie", "--board", "segway", "--controller", "stand"]
+    line = _refused(capsys, [*argv, "--out", str(tmp_path / "o")])
+    assert str(root) in line, line
+    assert not (tmp_path / "o").exists()
