@@ -34,7 +34,7 @@ def validate(path: Path, raw: dict[str, Any], model: type[Model]) -> Model:
     try:
         return model.model_validate(raw)
     except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+        raise ConfigError.from_validation(path, exc, model) from exc
 
 
 def load_checked(path: Path, model: type[Model], what: str) -> Model:

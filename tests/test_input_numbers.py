@@ -246,3 +246,42 @@ def test_platform_offsets_need_independent_platforms(capsys, tmp_path: Path) -> 
         err = capsys.readouterr().err
         assert code == 2 and "platform_offsets" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+def _tables(raw: Any, path: tuple[Any, ...] = ()) -> Iterator[tuple[Any, ...]]:
+    """The path of every table (dict) in a parsed tree, the top level included."""
+    if isinstance(raw, dict):
+        yield path
+        for key, value in raw.items():
+            if key != "metadata":
+                yield from _tables(value, (*path, key))
+    elif isinstance(raw, list):
+        for i, value in enumerate(raw):
+            yield from _tables(value, (*path, i))
+
+
+def _table_cases() -> Iterator[Any]:
+    for name, model, raw in _files():
+        for path in _tables(raw):
+            yield pytest.param(model, raw, path, id=f"{name}:{_dotted(path) or 'top'}")
+
+
+@pytest.mark.parametrize(("model", "raw", "path"), list(_table_cases()))
+def test_an_unknown_key_names_the_keys_its_table_takes(model, raw, path) -> None:
+    table = json.loads(json.dumps(raw))
+    node = table
+    for part in path:
+        node = node[part]
+    existing = list(node)
+    node["zz_typo"] = 1.0
+    try:
+        validate(Path("file.toml"), table, model)
+    except ConfigError as refused:
+        message = str(refused)
+    else:  # a mapping of names to numbers takes any name
+        assert path[-1] in ("board_final",), path
+        return
+    assert f"'{_dotted((*path, 'zz_typo'))}'" in message, message
+    if "unknown key" in message:  # a table of fields, not a mapping of names (motors)
+        allowed = message.split("allowed: ")[1].split(", ")
+        assert set(existing) <= set(allowed), message

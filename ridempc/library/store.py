@@ -153,7 +153,7 @@ def read_manifest(folder: Path) -> Manifest:
     try:
         manifest = Manifest.model_validate(raw)
     except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+        raise ConfigError.from_validation(path, exc, Manifest) from exc
     names = [e.name for e in manifest.entries]
     for entry in manifest.entries:
         if entry.file != f"{entry.name}.npz":
