@@ -53,7 +53,7 @@ __all__ = [
     "load_scenario_file",
 ]
 
-# Command bounds: beyond what any board carries a rider at (the Segway's 5 m/s top speed,
+# Command bounds: beyond what any board carries a rider at (the Segway's 4.44 m/s top speed,
 # a spin of 2 turns a second, a stance change of half a metre, the skateboard's 0.5 rad roll
 # limit), so a value outside them is a typo, not an experiment.
 Velocity = Annotated[Real, Field(ge=-10.0, le=10.0, description="[m/s]")]
@@ -120,7 +120,7 @@ class CommandWave(_Frozen):
     :math:`a \sin(2\pi (t - t_0) / T)` (the skateboard's roll reference, the wave pattern)."""
 
     field: Literal["velocity", "yaw_rate", "lateral_offset", "roll"]
-    amplitude: Annotated[Real, Field(ge=-10.0, le=10.0)]  # the field's unit; as its bounds
+    amplitude: Annotated[Real, Field(ge=-10.0, le=10.0)]  # the field's unit; the widest bound
     period: Duration
     start: Time = 0.0
     stop: Duration = MAX_DURATION
