@@ -30,7 +30,7 @@ from ridempc.checks import writable_dir
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.io import atomic_savefig, atomic_write_json, atomic_write_text
 from ridempc.options import MAX_SEEDS
-from ridempc.results import clear_results
+from ridempc.results import check_clearable, clear_results
 from ridempc.run import RideRequest, check_request, ride
 
 __all__ = ["COMPARED_METRICS", "ComparisonRow", "compare", "comparison_table"]
@@ -187,6 +187,7 @@ def compare(
         UnknownNameError: A name that does not exist (before anything runs).
     """
     out = writable_dir(Path(out), "--out folder")
+    check_clearable(out)
     if not 1 <= seeds <= MAX_SEEDS:
         raise ConfigError(f"--seeds {seeds}: allowed: a whole number in [1, {MAX_SEEDS}]")
     if len(controllers) < 2 or len(set(controllers)) != len(controllers):

@@ -13,7 +13,9 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-__all__ = ["COMPARISON_FILES", "RUN_FILES", "clear_results"]
+from ridempc.errors import ConfigError
+
+__all__ = ["COMPARISON_FILES", "RUN_FILES", "check_clearable", "clear_results"]
 
 # What ``ridempc sim`` writes (summary.json first: its absence marks an unfinished run).
 RUN_FILES: tuple[str, ...] = ("summary.json", "log.npz", "plots.png", "video.mp4", "snapshots.png")
@@ -21,6 +23,18 @@ RUN_FILES: tuple[str, ...] = ("summary.json", "log.npz", "plots.png", "video.mp4
 COMPARISON_FILES: tuple[str, ...] = ("comparison.json", "comparison.md", "overlay.png")
 
 _SEED_FOLDER = re.compile(r"^seed-[0-9]+$")
+
+
+def check_clearable(folder: Path) -> None:
+    """Refuse a folder where a name ridempc writes is taken by something it cannot replace
+    (a folder called ``log.npz``), before any work starts."""
+    for name in (*RUN_FILES, *COMPARISON_FILES):
+        taken = folder / name
+        if taken.is_dir() and not taken.is_symlink():
+            raise ConfigError(
+                f"{taken}: a folder where ridempc writes its file '{name}'; "
+                "allowed: an --out folder without it"
+            )
 
 
 def clear_results(folder: Path) -> None:
@@ -41,10 +55,12 @@ def clear_results(folder: Path) -> None:
 
 def _remove(folder: Path, names: tuple[str, ...]) -> None:
     for name in names:
-        (folder / name).unlink(missing_ok=True)
-        for stale in folder.glob(f".{name}.*"):  # its temporary files: ".<name>.<...>"
-            if stale.is_file():
-                stale.unlink(missing_ok=True)
+        stale = [folder / name, *(p for p in folder.glob(f".{name}.*") if p.is_file())]
+        for path in stale:  # the file and its temporary files, ".<name>.<...>"
+            try:
+                path.unlink(missing_ok=True)
+            except OSError as exc:
+                raise ConfigError(f"{path}: cannot remove an earlier run's file ({exc})") from exc
 
 
 def _remove_if_empty(folder: Path) -> None:

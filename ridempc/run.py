@@ -20,7 +20,7 @@ from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
 from ridempc.errors import ConfigError
 from ridempc.io import atomic_write_json, atomic_write_npz
-from ridempc.results import clear_results
+from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -117,6 +117,7 @@ def check_request(request: RideRequest) -> CheckedRide:
             the robot-board pair or its scene.
     """
     out = writable_dir(Path(request.out), "--out folder")
+    check_clearable(out)
     if request.duration is not None and not MIN_DURATION <= request.duration <= MAX_DURATION:
         raise ConfigError(  # NaN fails the comparison too
             f"--duration {request.duration}: allowed: seconds in "

@@ -154,3 +154,18 @@ def test_bad_input_found_on_the_scene_keeps_the_earlier_results(capsys, tmp_path
     err = capsys.readouterr().err
     assert code == 2 and "'tail'" in err and len(err.strip().splitlines()) == 1
     assert sorted(out.rglob("*")) == before
+
+
+@pytest.mark.parametrize("name", [*RUN_FILES, *COMPARISON_FILES])
+def test_a_folder_in_place_of_a_result_file_is_refused_first(capsys, tmp_path, name) -> None:
+    out = tmp_path / "taken"
+    _stale(out)
+    (out / name).unlink(missing_ok=True)
+    (out / name).mkdir()
+    before = sorted(out.rglob("*"))
+    for argv in ([*SIM, "--out", str(out)], [*COMPARE, "--controllers", "stand,pd", "--out",
+                 str(out)]):  # fmt: skip
+        code = main(argv)
+        err = capsys.readouterr().err
+        assert code == 2 and f"'{name}'" in err and len(err.strip().splitlines()) == 1, err
+        assert sorted(out.rglob("*")) == before
