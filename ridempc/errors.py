@@ -15,6 +15,7 @@ __all__ = [
     "RidempcError",
     "SimulationDiverged",
     "UnknownNameError",
+    "WriteFailed",
 ]
 
 
@@ -115,3 +116,15 @@ class SimulationDiverged(RidempcError, RuntimeError):
         self.time = time
         self.what = what
         super().__init__(f"simulation diverged at t = {time:.4f} s: {what}")
+
+
+class WriteFailed(RidempcError, OSError):
+    """A result that could not be written (disk full, folder removed); nothing half-written
+    is left, and the command fails with code 1."""
+
+    def __init__(self, path: Path, reason: OSError) -> None:
+        self.path = path
+        super().__init__(f"{path}: cannot write it ({reason.strerror or reason}); nothing written")
+
+    def __str__(self) -> str:  # OSError would format its own way
+        return str(self.args[0])

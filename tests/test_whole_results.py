@@ -169,3 +169,17 @@ def test_a_folder_in_place_of_a_result_file_is_refused_first(capsys, tmp_path, n
         err = capsys.readouterr().err
         assert code == 2 and f"'{name}'" in err and len(err.strip().splitlines()) == 1, err
         assert sorted(out.rglob("*")) == before
+
+
+def test_a_result_that_cannot_be_written_fails_with_one_line(capsys, tmp_path, monkeypatch) -> None:
+    import ridempc.io
+
+    def full(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(ridempc.io.os, "fsync", full)
+    out = tmp_path / "full"
+    code = main([*SIM, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1 and "No space left on device" in err and len(err.strip().splitlines()) == 1
+    assert not (out / "summary.json").exists() and not list(out.glob(".*"))
