@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 from ridempc.boards import NO_BOARD, load_board
 from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
-from ridempc.errors import ConfigError
+from ridempc.errors import ConfigError, WriteFailed
 from ridempc.io import atomic_write_json, atomic_write_npz
 from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
@@ -196,7 +196,10 @@ def ride(request: RideRequest) -> dict[str, Any]:
 
     out = checked.out  # nothing is removed or written before this point
     clear_results(out)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # the folder changed since it was checked
+        raise WriteFailed(out, exc) from exc
     video = None
     viewer = None
     strip = None
