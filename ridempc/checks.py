@@ -86,7 +86,7 @@ def text_file(path: Path, what: str) -> str:
     except OSError as exc:
         raise ConfigError(f"{path}: {what} is not readable ({exc.strerror})") from None
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")  # a byte-order mark, as some editors write, is fine
     except UnicodeDecodeError as exc:
         raise ConfigError(
             f"{path}: {what} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start})"
