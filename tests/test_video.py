@@ -6,6 +6,7 @@ import json
 
 import imageio_ffmpeg
 import numpy as np
+import pytest
 
 from ridempc.cli import main
 
@@ -40,8 +41,10 @@ def test_snapshot_strip_is_written(tmp_path) -> None:
 
 def test_negative_snapshot_count_is_refused(tmp_path, capsys) -> None:
     out = tmp_path / "bad"
-    assert main(["sim", "--snapshots", "-1", "--out", str(out)]) == 2
-    assert "--snapshots -1" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exited:  # argparse's error, one line
+        main(["sim", "--snapshots", "-1", "--out", str(out)])
+    assert exited.value.code == 2
+    assert "--snapshots: -1 is out of range" in capsys.readouterr().err
     assert not out.exists()
 
 

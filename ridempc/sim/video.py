@@ -74,9 +74,11 @@ class VideoRecorder:
         self.frames += 1
 
     def close(self, keep: bool = True) -> None:
-        self._writer.close()
-        self._renderer.close()
-        if keep and self.frames:
-            self._tmp.replace(self.path)
-        else:
+        """Finish the file and rename it into place (``keep`` and frames), else remove it."""
+        try:
+            self._writer.close()
+            self._renderer.close()
+            if keep and self.frames:
+                self._tmp.replace(self.path)
+        finally:
             self._tmp.unlink(missing_ok=True)
