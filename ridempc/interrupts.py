@@ -1,0 +1,323 @@
+"""SIGINT and SIGTERM end a command at once, whichever solver is running.
+
+The command line runs each command inside :func:`handled`: the first SIGINT or SIGTERM
+raises :class:`Interrupted` in the main thread, the command unwinds (its ``finally`` blocks
+remove temporary files) and ``ridempc`` exits with 128 + the signal's number (130, 143)
+after one line on standard error. A further signal, while that cleanup or the interpreter's
+shutdown runs, ends the process at once with the same code, without a traceback.
+
+Third-party solvers take SIGINT for themselves, and :func:`solver_returned` (or its OSQP
+form, :func:`osqp_returned`) is called after each of their solves to undo it:
+
+- **OSQP** (1.x; the C library in the ``osqp`` package is built with
+  ``OSQP_ENABLE_INTERRUPT``) installs its own handler with ``sigaction`` at the start of every
+  solve (``osqp_start_interrupt_listener``) and puts back, at its end, the handler it saved in
+  one static variable (``osqp_end_interrupt_listener``). A SIGINT during a solve only ends
+  that solve, with status ``OSQP_SIGINT`` ("interrupted"), which a controller takes for one
+  failed solve. Two solves that overlap in two threads (the MPC's solver thread beside the
+  whole-body QP in the control loop) save each other's handler, so OSQP's stays installed
+  for good: Python never hears of a Ctrl-C again, however often it is pressed.
+  :func:`osqp_returned` puts the command's handler back at the C level (``sigaction``,
+  from whichever thread) and passes a SIGINT that OSQP caught on to the main thread: one
+  that ended the solve, and one that arrived after OSQP's last look at its flag
+  (``osqp_is_interrupted``, which the library exports), e.g. during the polish.
+- **CasADi** runs Python's handler from inside IPOPT's evaluations and turns the exception
+  into IPOPT's failure ``NonIpopt_Exception_Thrown`` (the interrupt would become one failed
+  library entry) with a warning line on standard error; :func:`casadi_solve` drops that line
+  and raises the interrupt again once IPOPT has returned.
+
+Worker processes (``library build --jobs N``) leave signals to their parent
+(:func:`worker_started`), which ends them with :func:`stop_workers`.
+"""
+
+from __future__ import annotations
+
+import _thread
+import ctypes
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor
+from contextlib import contextmanager
+from functools import cache
+from types import FrameType
+from typing import Any, NoReturn, TextIO, cast
+
+__all__ = [
+    "SIGNALS",
+    "Handling",
+    "Interrupted",
+    "casadi_solve",
+    "handled",
+    "osqp_returned",
+    "solver_returned",
+    "stop_workers",
+    "worker_started",
+]
+
+SIGNALS: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)  # the ones that stop
+# Bytes read and written as an opaque ``struct sigaction``: more than any platform's (152 on
+# Linux x86-64), so the C library never reads or writes past the buffer.
+_SIGACTION_BYTES: int = 512
+_PR_SET_PDEATHSIG: int = 1  # prctl(2) option: the signal a process gets when its parent dies
+_WORKER_JOIN_S: float = 0.2  # [s] wait for each terminated worker (SIGTERM kills at once)
+# CasADi's warning when IPOPT's evaluation raised KeyboardInterrupt (dropped, see casadi_solve).
+_CASADI_INTERRUPT_WARNING: str = "KeyboardInterruptException"
+
+
+class Interrupted(KeyboardInterrupt):
+    """A command stopped by SIGINT or SIGTERM.
+
+    A ``KeyboardInterrupt``, so that ``except Exception`` (a controller's safe hold, a
+    solver's error handling) does not take it for a failure and carry on.
+
+    Attributes:
+        signum: The signal's number.
+    """
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(self.name)
+
+    @property
+    def name(self) -> str:
+        """The signal's name, e.g. ``SIGINT``."""
+        return signal.Signals(self.signum).name
+
+    @property
+    def exit_code(self) -> int:
+        """The shell's code for a process ended by the signal: 128 + its number."""
+        return 128 + self.signum
+
+
+def _libc() -> Any:
+    return ctypes.CDLL(None, use_errno=True)
+
+
+def _disposition(signum: int) -> ctypes.Array[ctypes.c_char] | None:
+    """The C-level ``struct sigaction`` of ``signum`` (opaque bytes), None where there is no
+    ``sigaction`` (not POSIX)."""
+    if os.name != "posix":
+        return None
+    action = ctypes.create_string_buffer(_SIGACTION_BYTES)
+    if _libc().sigaction(signum, None, action) != 0:
+        return None
+    return action
+
+
+class Handling:
+    """The signal handling of one command (made by :func:`handled`).
+
+    Attributes:
+        unwritten: What the interrupted command leaves incomplete, for its one line, e.g.
+            ``no summary.json was written in runs/x``.
+        received: The first signal received, or None.
+        reported: Whether the one line has been written.
+    """
+
+    def __init__(self, unwritten: str) -> None:
+        self.unwritten = unwritten
+        self.received: int | None = None
+        self.reported = False
+        self._action = _disposition(signal.SIGINT)  # Python's own C handler, installed by now
+
+    def on_signal(self, signum: int, frame: FrameType | None) -> None:
+        """The first signal raises :class:`Interrupted`; any further one ends the process."""
+        if self.received is not None:
+            self.exit_now(signum, frame)
+        self.received = signum
+        raise Interrupted(signum)
+
+    def exit_now(self, signum: int, frame: FrameType | None) -> NoReturn:
+        """End the process at once (a second signal during cleanup or shutdown)."""
+        os._exit(self.report(signum, raw=True))
+
+    def report(self, signum: int | None = None, raw: bool = False) -> int:
+        """Write the one line (once) and return the exit code.
+
+        Args:
+            signum: The signal, if none was received (a ``KeyboardInterrupt`` raised by
+                code: SIGINT).
+            raw: Write to file descriptor 2 rather than through ``sys.stderr``, which the
+                main thread may be in the middle of (from a signal handler).
+        """
+        number = self.received or signum or signal.SIGINT
+        if not self.reported:
+            self.reported = True
+            line = f"ridempc: interrupted ({signal.Signals(number).name}); {self.unwritten}\n"
+            try:
+                if raw:
+                    os.write(2, line.encode())
+                else:
+                    sys.stderr.write(line)
+                    sys.stderr.flush()
+            except (OSError, ValueError):
+                pass  # standard error closed: the exit code still says it
+        return 128 + number
+
+    def restore(self) -> None:
+        """Python's C-level SIGINT handler back in place (callable from any thread)."""
+        if self._action is not None:
+            _libc().sigaction(signal.SIGINT, self._action, None)
+
+
+_active: Handling | None = None  # the command's handling; None outside the command line
+
+
+@contextmanager
+def handled(unwritten: str) -> Iterator[Handling]:
+    """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread while a command runs.
+
+    On leaving, the previous handlers are put back, unless a signal was received: then the
+    process is ending, and a further signal ends it at once (:meth:`Handling.exit_now`)
+    rather than interrupting the interpreter's shutdown with a traceback.
+
+    Args:
+        unwritten: What an interrupted command leaves incomplete (:class:`Handling`).
+
+    Raises:
+        RuntimeError: Not called from the main thread.
+    """
+    global _active
+    if threading.current_thread() is not threading.main_thread():
+        raise RuntimeError("signal handlers can only be installed from the main thread")
+    previous = {s: signal.getsignal(s) for s in SIGNALS}
+    for s in SIGNALS:
+        signal.signal(s, _dispatch)
+    handling = Handling(unwritten)
+    outer, _active = _active, handling
+    try:
+        yield handling
+    finally:
+        if handling.received is None:
+            _active = outer
+            for s, handler in previous.items():
+                signal.signal(s, handler)
+        else:
+            for s in SIGNALS:
+                signal.signal(s, handling.exit_now)
+
+
+def _dispatch(signum: int, frame: FrameType | None) -> None:
+    handling = _active
+    if handling is None:  # cannot happen while installed; a plain Ctrl-C then
+        raise KeyboardInterrupt
+    handling.on_signal(signum, frame)
+
+
+def solver_returned(caught: bool = False) -> None:
+    """Call after each solve by a library that installs its own SIGINT handler (OSQP):
+    puts the command's handler back and passes the interrupt on.
+
+    Outside :func:`handled` (the package used as a library, the tests) it does nothing.
+
+    Args:
+        caught: Whether the solver reports that it caught a SIGINT (OSQP's status
+            ``OSQP_SIGINT``); it is delivered to the main thread, as if it had arrived there.
+
+    Raises:
+        Interrupted: In the main thread, when a signal has been received (also one that a
+            library caught and swallowed).
+    """
+    handling = _active
+    if handling is None:
+        return
+    handling.restore()
+    if caught and handling.received is None:  # (two solves may report the same signal)
+        _thread.interrupt_main(signal.SIGINT)  # runs the handler in the main thread
+    if handling.received is not None and threading.current_thread() is threading.main_thread():
+        raise Interrupted(handling.received)
+
+
+@cache
+def _osqp_flag() -> Callable[[], int] | None:
+    """OSQP's ``osqp_is_interrupted()``: whether its handler caught a SIGINT since the
+    latest solve began (None where the compiled library does not export it)."""
+    try:
+        from osqp import ext_builtin
+
+        return cast(Callable[[], int], ctypes.CDLL(ext_builtin.__file__).osqp_is_interrupted)
+    except (ImportError, OSError, AttributeError):
+        return None
+
+
+def osqp_returned(status_val: int) -> None:
+    """:func:`solver_returned` after an OSQP solve with status ``status_val``.
+
+    A SIGINT that OSQP's handler caught is passed on when the solve says so (status
+    ``OSQP_SIGINT``) and also when it does not: OSQP looks at its flag once per iteration,
+    so a signal during the last iteration or the polish ends the solve as solved, and the
+    next solve's start would clear the flag.
+    """
+    if _active is None:
+        return
+    import osqp
+
+    flag = _osqp_flag()
+    caught = status_val == osqp.SolverStatus.OSQP_SIGINT or (flag is not None and flag() != 0)
+    solver_returned(caught)
+
+
+class _DropInterruptWarning:
+    """Standard error, without CasADi's warning line about the interrupt."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        if _CASADI_INTERRUPT_WARNING in text:
+            return len(text)
+        return self._stream.write(text)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def casadi_solve() -> Iterator[None]:
+    """Around a CasADi/IPOPT solve (module docstring): CasADi's warning line about the
+    interrupt is dropped, and an interrupt raised during the solve is raised again after it.
+
+    Raises:
+        Interrupted: A signal was received during the solve.
+    """
+    if _active is None:
+        yield
+        return
+    stream = sys.stderr
+    sys.stderr = _DropInterruptWarning(stream)
+    try:
+        yield
+    finally:
+        sys.stderr = stream
+    solver_returned()
+
+
+def worker_started() -> None:
+    """Initializer of worker processes: signals are the parent's business.
+
+    SIGINT (a terminal sends it to the whole process group) is ignored, SIGTERM (sent by the
+    parent's :func:`stop_workers`) ends the worker at once, and on Linux the worker is
+    killed when its parent dies, even when the parent is killed outright.
+    """
+    global _active
+    _active = None  # a forked copy of the parent's handling is not this process's
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if sys.platform.startswith("linux"):
+        _libc().prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+
+
+def stop_workers(executor: Executor) -> None:
+    """Cancel what ``executor`` has not started and end its worker processes now, without
+    waiting for the solves under way (a ``ProcessPoolExecutor``; others are shut down)."""
+    # The pool's worker processes: concurrent.futures has no public accessor for them.
+    processes = list((getattr(executor, "_processes", None) or {}).values())
+    executor.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    for process in processes:
+        process.join(_WORKER_JOIN_S)
