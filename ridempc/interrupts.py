@@ -4,7 +4,9 @@ The command line runs each command inside :func:`handled`: the first SIGINT or S
 raises :class:`Interrupted` in the main thread, the command unwinds (its ``finally`` blocks
 remove temporary files) and ``ridempc`` exits with 128 + the signal's number (130, 143)
 after one line on standard error. A further signal, while that cleanup or the interpreter's
-shutdown runs, ends the process at once with the same code, without a traceback.
+shutdown runs, ends the process at once with the same code, without a traceback; and a
+process still there ``DEADLINE_S`` after the first signal (its main thread held in compiled
+code) is ended by a watchdog thread, also with the same code and line.
 
 Third-party solvers take SIGINT for themselves, and :func:`solver_returned` (or its OSQP
 form, :func:`osqp_returned`) is called after each of their solves to undo it:
@@ -38,6 +40,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor
 from contextlib import contextmanager
@@ -46,6 +49,7 @@ from types import FrameType
 from typing import Any, NoReturn, TextIO, cast
 
 __all__ = [
+    "DEADLINE_S",
     "SIGNALS",
     "Handling",
     "Interrupted",
@@ -61,6 +65,9 @@ SIGNALS: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)  # the one
 # Bytes read and written as an opaque ``struct sigaction``: more than any platform's (152 on
 # Linux x86-64), so the C library never reads or writes past the buffer.
 _SIGACTION_BYTES: int = 512
+# [s] from a signal to the end of a process that has not ended by itself: within the second
+# the command line promises, after the ~0.1-0.6 s a command takes to unwind and exit.
+DEADLINE_S: float = 0.7
 _PR_SET_PDEATHSIG: int = 1  # prctl(2) option: the signal a process gets when its parent dies
 _WORKER_JOIN_S: float = 0.2  # [s] wait for each terminated worker (SIGTERM kills at once)
 # CasADi's warning when IPOPT's evaluation raised KeyboardInterrupt (dropped, see casadi_solve).
@@ -149,7 +156,7 @@ class Handling:
             line = f"ridempc: interrupted ({signal.Signals(number).name}); {self.unwritten}\n"
             try:
                 if raw:
-                    os.write(2, line.encode())
+                    os.write(2, (("\n" if _open_progress_bar() else "") + line).encode())
                 else:
                     sys.stderr.write(line)
                     sys.stderr.flush()
@@ -166,13 +173,59 @@ class Handling:
 _active: Handling | None = None  # the command's handling; None outside the command line
 
 
+def _open_progress_bar() -> bool:
+    """Whether a tqdm bar (which leaves its line unfinished) is open on standard error."""
+    tqdm = getattr(sys.modules.get("tqdm"), "tqdm", None)
+    return bool(getattr(tqdm, "_instances", None))  # tqdm's set of open bars
+
+
+class _Watchdog:
+    """Ends the process ``DEADLINE_S`` after a signal if the command has not ended by then.
+
+    Python runs a signal's handler only when the main thread is back in the interpreter;
+    a long call into compiled code (CasADi building an NLP: 7-19 s for a Cassie entry)
+    would hold the interrupt, and the second signal's, until it returns. Python's own C
+    handler writes the signal's number to the wakeup file descriptor at once, also when
+    :func:`solver_returned` passes on one that OSQP caught, and this thread, blocked on
+    the other end of that pipe, needs no more of the interpreter than the compiled call
+    leaves free (CasADi and OSQP release its lock).
+    """
+
+    def __init__(self, handling: Handling) -> None:
+        self._handling = handling
+        self._read, self._write = os.pipe()
+        os.set_blocking(self._write, False)  # set_wakeup_fd requires it
+        self._previous = signal.set_wakeup_fd(self._write, warn_on_full_buffer=False)
+        self._thread = threading.Thread(target=self._watch, name="ridempc-interrupts", daemon=True)
+        self._thread.start()
+
+    def _watch(self) -> None:
+        byte = os.read(self._read, 1)  # a signal's number, or 0 when the command ended
+        if byte and byte[0] != 0:
+            time.sleep(DEADLINE_S)
+            self._handling.exit_now(byte[0], None)
+
+    def close(self) -> None:
+        """Stop watching, unless a signal was received: then the process is ending, and
+        the watchdog ends it at the deadline if it is still there."""
+        if self._handling.received is not None:
+            return
+        signal.set_wakeup_fd(self._previous)
+        os.write(self._write, b"\0")
+        self._thread.join()
+        os.close(self._read)
+        os.close(self._write)
+
+
 @contextmanager
 def handled(unwritten: str) -> Iterator[Handling]:
     """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread while a command runs.
 
     On leaving, the previous handlers are put back, unless a signal was received: then the
     process is ending, and a further signal ends it at once (:meth:`Handling.exit_now`)
-    rather than interrupting the interpreter's shutdown with a traceback.
+    rather than interrupting the interpreter's shutdown with a traceback. Whatever the
+    main thread is doing, the process ends ``DEADLINE_S`` after the first signal at the
+    latest (:class:`_Watchdog`), with the same code and line.
 
     Args:
         unwritten: What an interrupted command leaves incomplete (:class:`Handling`).
@@ -187,10 +240,12 @@ def handled(unwritten: str) -> Iterator[Handling]:
     for s in SIGNALS:
         signal.signal(s, _dispatch)
     handling = Handling(unwritten)
+    watchdog = _Watchdog(handling)
     outer, _active = _active, handling
     try:
         yield handling
     finally:
+        watchdog.close()
         if handling.received is None:
             _active = outer
             for s, handler in previous.items():
@@ -304,6 +359,7 @@ def worker_started() -> None:
     """
     global _active
     _active = None  # a forked copy of the parent's handling is not this process's
+    signal.set_wakeup_fd(-1)  # nor its watchdog's pipe
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
