@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ridempc.errors import ConfigError, RidempcError, UnknownNameError
 from ridempc.interrupts import handled
+from ridempc.paths import motion_library_dir
 
 __all__ = ["main"]
 
@@ -262,7 +263,7 @@ def _unwritten(args: argparse.Namespace) -> str:
     if args.command == "board":
         return "no result" + (f" was written to {args.json}" if args.json else " was printed")
     if args.command == "library" and args.library_command == "build":
-        folder = args.out or f"motion_library/{args.robot}-{args.board}"
+        folder = args.out or motion_library_dir() / f"{args.robot}-{args.board}"
         return f"the entries under way were not stored in {folder} (the stored ones are complete)"
     if args.command == "library" and args.plot is not None:
         return f"no plot was written to {args.plot}"
@@ -303,9 +304,10 @@ def _finish(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
-    with handled(_unwritten(args)) as handling:
+    with handled("nothing was written") as handling:
         try:
+            args = _parser().parse_args(argv)
+            handling.unwritten = _unwritten(args)
             code = _finish(args)
         except BaseException as exc:
             if handling.received is None and not isinstance(exc, KeyboardInterrupt):
