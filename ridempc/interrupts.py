@@ -3,10 +3,10 @@
 The command line runs each command inside :func:`handled`: the first SIGINT or SIGTERM
 raises :class:`Interrupted` in the main thread, the command unwinds (its ``finally`` blocks
 remove temporary files) and ``ridempc`` exits with 128 + the signal's number (130, 143)
-after one line on standard error. A further signal, while that cleanup or the interpreter's
-shutdown runs, ends the process at once with the same code, without a traceback; and a
-process still there ``DEADLINE_S`` after the first signal (its main thread held in compiled
-code) is ended by a watchdog thread, also with the same code and line.
+after one line on standard error. A further signal while that cleanup runs ends the
+process at once with the same code, one during the interpreter's shutdown is ignored, and
+a process still there ``DEADLINE_S`` after the first signal (its main thread held in
+compiled code, say) is ended by a watchdog thread: never a traceback, always that code.
 
 Third-party solvers take SIGINT for themselves, and :func:`solver_returned` (or its OSQP
 form, :func:`osqp_returned`) is called after each of their solves to undo it:
@@ -25,8 +25,11 @@ form, :func:`osqp_returned`) is called after each of their solves to undo it:
   (``osqp_is_interrupted``, which the library exports), e.g. during the polish.
 - **CasADi** runs Python's handler from inside IPOPT's evaluations and turns the exception
   into IPOPT's failure ``NonIpopt_Exception_Thrown`` (the interrupt would become one failed
-  library entry) with a warning line on standard error; :func:`casadi_solve` drops that line
-  and raises the interrupt again once IPOPT has returned.
+  library entry), or into a ``SystemError`` when it lands in a conversion of CasADi's own;
+  :func:`casadi_solve` raises the interrupt again once the solve has returned.
+
+The solvers' own words about the interrupt (OSQP prints ``Solver interrupted``, CasADi a
+warning line) are left out of standard output and error while a command runs.
 
 Worker processes (``library build --jobs N``) leave signals to their parent
 (:func:`worker_started`), which ends them with :func:`stop_workers`.
@@ -43,7 +46,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from functools import cache
 from types import FrameType
 from typing import Any, NoReturn, TextIO, cast
@@ -70,8 +73,11 @@ _SIGACTION_BYTES: int = 512
 DEADLINE_S: float = 0.7
 _PR_SET_PDEATHSIG: int = 1  # prctl(2) option: the signal a process gets when its parent dies
 _WORKER_JOIN_S: float = 0.2  # [s] wait for each terminated worker (SIGTERM kills at once)
-# CasADi's warning when IPOPT's evaluation raised KeyboardInterrupt (dropped, see casadi_solve).
-_CASADI_INTERRUPT_WARNING: str = "KeyboardInterruptException"
+_OSQP_INTERRUPTED: str = "Solver interrupted\n"  # what OSQP prints when its handler caught one
+# How CasADi's messages begin, and its warnings (IPOPT's evaluation raised the interrupt:
+# ``CasADi - <time> WARNING("KeyboardInterruptException") [...ipopt_nlp.cpp:132]``).
+_CASADI_PREFIX: str = "CasADi - "
+_CASADI_WARNING: str = " WARNING("
 
 
 class Interrupted(KeyboardInterrupt):
@@ -221,9 +227,11 @@ class _Watchdog:
 def handled(unwritten: str) -> Iterator[Handling]:
     """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread while a command runs.
 
-    On leaving, the previous handlers are put back, unless a signal was received: then the
-    process is ending, and a further signal ends it at once (:meth:`Handling.exit_now`)
-    rather than interrupting the interpreter's shutdown with a traceback. Whatever the
+    A second signal while the command unwinds ends the process at once
+    (:meth:`Handling.exit_now`). On leaving, the previous handlers and streams are put
+    back, unless a signal was received: then the process is ending, and further signals are
+    ignored rather than interrupting the interpreter's shutdown with a traceback or, once
+    Python has reset its handlers, killing it with a code other than 130/143. Whatever the
     main thread is doing, the process ends ``DEADLINE_S`` after the first signal at the
     latest (:class:`_Watchdog`), with the same code and line.
 
@@ -241,18 +249,26 @@ def handled(unwritten: str) -> Iterator[Handling]:
         signal.signal(s, _dispatch)
     handling = Handling(unwritten)
     watchdog = _Watchdog(handling)
+    streams = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Muted(sys.stdout, handling), _Muted(sys.stderr, handling)
     outer, _active = _active, handling
     try:
         yield handling
     finally:
+        for muted in (sys.stdout, sys.stderr):
+            if isinstance(muted, _Muted):
+                with suppress(OSError, ValueError):  # a closed stream: nothing to say there
+                    muted.flush()
+        if handling.received is None:  # (else the solvers may still have words to say)
+            sys.stdout, sys.stderr = streams
         watchdog.close()
         if handling.received is None:
             _active = outer
             for s, handler in previous.items():
                 signal.signal(s, handler)
-        else:
+        else:  # the process is ending (by DEADLINE_S at the latest: the watchdog)
             for s in SIGNALS:
-                signal.signal(s, handling.exit_now)
+                signal.signal(s, signal.SIG_IGN)
 
 
 def _dispatch(signum: int, frame: FrameType | None) -> None:
@@ -315,38 +331,52 @@ def osqp_returned(status_val: int) -> None:
     solver_returned(caught)
 
 
-class _DropInterruptWarning:
-    """Standard error, without CasADi's warning line about the interrupt."""
+class _Muted:
+    """A standard stream without the solvers' own words about an interrupt, which the
+    command's line replaces: OSQP's ``Solver interrupted`` (one write) and, once a signal
+    has been received, CasADi's warnings (lines CasADi writes in pieces, held until
+    complete)."""
 
-    def __init__(self, stream: TextIO) -> None:
-        self._stream = stream
+    def __init__(self, stream: TextIO, handling: Handling) -> None:
+        self.stream = stream
+        self._handling = handling
+        self._line = ""
 
     def write(self, text: str) -> int:
-        if _CASADI_INTERRUPT_WARNING in text:
+        if text == _OSQP_INTERRUPTED:
             return len(text)
-        return self._stream.write(text)
+        if not (self._line or text.startswith(_CASADI_PREFIX)):
+            return self.stream.write(text)
+        self._line += text
+        if "\n" in text:
+            line, self._line = self._line, ""
+            if not (_CASADI_WARNING in line and self._handling.received is not None):
+                self.stream.write(line)
+        return len(text)
+
+    def flush(self) -> None:
+        if self._line:  # a CasADi line that has not ended
+            self.stream.write(self._line)
+            self._line = ""
+        self.stream.flush()
 
     def __getattr__(self, name: str) -> Any:
-        return getattr(self._stream, name)
+        return getattr(self.stream, name)
 
 
 @contextmanager
 def casadi_solve() -> Iterator[None]:
-    """Around a CasADi/IPOPT solve (module docstring): CasADi's warning line about the
-    interrupt is dropped, and an interrupt raised during the solve is raised again after it.
+    """Around a CasADi solve (IPOPT, HPIPM; module docstring): an interrupt that CasADi
+    turned into a failed solve, or into an error of its own, is raised again after it.
 
     Raises:
         Interrupted: A signal was received during the solve.
     """
-    if _active is None:
-        yield
-        return
-    stream = sys.stderr
-    sys.stderr = _DropInterruptWarning(stream)
     try:
         yield
-    finally:
-        sys.stderr = stream
+    except Exception:
+        if _active is None or _active.received is None:
+            raise
     solver_returned()
 
 

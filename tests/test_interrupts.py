@@ -48,10 +48,14 @@ def _wait_for(path: Path, process: subprocess.Popen[str], timeout: float = 60.0)
         time.sleep(0.02)
 
 
-def _stop(process: subprocess.Popen[str], signum: int) -> tuple[float, str, str]:
-    """Send ``signum``; the seconds until the process ended, its stdout and stderr."""
+def _stop(process: subprocess.Popen[str], signum: int, count: int = 1) -> tuple[float, str, str]:
+    """Send ``signum`` (``count`` times, 50 ms apart, while the process is there); the
+    seconds from the first until the process ended, its stdout and stderr."""
     sent = time.monotonic()
-    process.send_signal(signum)
+    for _ in range(count):
+        if process.poll() is None:
+            process.send_signal(signum)
+            time.sleep(0.05)
     try:
         out, err = process.communicate(timeout=10.0)
     except subprocess.TimeoutExpired:
@@ -73,14 +77,17 @@ def _assert_interrupted(
 
 
 @pytest.mark.parametrize(
-    ("controller", "board", "signum"),
+    ("controller", "board", "signum", "count"),
     [
-        ("mpc", "hovershoes", signal.SIGINT),  # the README's first ride: OSQP iterating in
-        ("mpc", "hovershoes", signal.SIGTERM),  # the solver thread beside the WBC's QP
-        ("pd", "segway", signal.SIGINT),
+        ("mpc", "hovershoes", signal.SIGINT, 1),  # the README's first ride: OSQP iterating
+        ("mpc", "hovershoes", signal.SIGTERM, 1),  # in the solver thread beside the WBC's QP
+        ("mpc", "hovershoes", signal.SIGINT, 3),  # Ctrl-C pressed three times, 50 ms apart
+        ("pd", "segway", signal.SIGINT, 1),
     ],
 )
-def test_a_ride_stops_at_once(tmp_path: Path, controller: str, board: str, signum: int) -> None:
+def test_a_ride_stops_at_once(
+    tmp_path: Path, controller: str, board: str, signum: int, count: int
+) -> None:
     out = tmp_path / "ride"
     process = _start(
         "sim", "--robot", "cassie", "--board", board, "--controller", controller,
@@ -88,7 +95,7 @@ def test_a_ride_stops_at_once(tmp_path: Path, controller: str, board: str, signu
     )  # fmt: skip
     _wait_for(out, process)
     time.sleep(SETTLE_S)
-    seconds, _, err = _stop(process, signum)
+    seconds, _, err = _stop(process, signum, count)
     _assert_interrupted(process, seconds, err, signum, f"no summary.json was written in {out}")
     assert len(err.strip().splitlines()) == 1
     assert not (out / "summary.json").exists()
