@@ -68,9 +68,10 @@ SIGNALS: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)  # the one
 # Bytes read and written as an opaque ``struct sigaction``: more than any platform's (152 on
 # Linux x86-64), so the C library never reads or writes past the buffer.
 _SIGACTION_BYTES: int = 512
-# [s] from a signal to the end of a process that has not ended by itself: within the second
-# the command line promises, after the ~0.1-0.6 s a command takes to unwind and exit.
-DEADLINE_S: float = 0.7
+# [s] from a signal to the end of a process that has not ended by itself: a ride unwinds and
+# exits in 0.1-0.4 s; closing a --video ride's encoder and snapshots took 0.9 s in all, and
+# the watchdog itself waits for compiled code holding the interpreter's lock to let go.
+DEADLINE_S: float = 0.5
 _PR_SET_PDEATHSIG: int = 1  # prctl(2) option: the signal a process gets when its parent dies
 _WORKER_JOIN_S: float = 0.2  # [s] wait for each terminated worker (SIGTERM kills at once)
 _OSQP_INTERRUPTED: str = "Solver interrupted\n"  # what OSQP prints when its handler caught one
