@@ -106,7 +106,9 @@ class Interrupted(KeyboardInterrupt):
         return 128 + self.signum
 
 
+@cache
 def _libc() -> Any:
+    """The process's C library (``sigaction``, ``prctl``)."""
     return ctypes.CDLL(None, use_errno=True)
 
 
@@ -304,15 +306,20 @@ def solver_returned(caught: bool = False) -> None:
 
 
 @cache
-def _osqp_flag() -> Callable[[], int] | None:
-    """OSQP's ``osqp_is_interrupted()``: whether its handler caught a SIGINT since the
-    latest solve began (None where the compiled library does not export it)."""
+def _osqp() -> tuple[int, Callable[[], int] | None]:
+    """OSQP's status ``OSQP_SIGINT``, and its ``osqp_is_interrupted()``: whether its handler
+    caught a SIGINT since the latest solve began (None where the compiled library does not
+    export it)."""
+    import osqp
+
     try:
         from osqp import ext_builtin
 
-        return cast(Callable[[], int], ctypes.CDLL(ext_builtin.__file__).osqp_is_interrupted)
+        library = ctypes.CDLL(ext_builtin.__file__)
+        flag = cast(Callable[[], int], library.osqp_is_interrupted)
     except (ImportError, OSError, AttributeError):
-        return None
+        flag = None
+    return int(osqp.SolverStatus.OSQP_SIGINT), flag
 
 
 def osqp_returned(status_val: int) -> None:
@@ -325,11 +332,8 @@ def osqp_returned(status_val: int) -> None:
     """
     if _active is None:
         return
-    import osqp
-
-    flag = _osqp_flag()
-    caught = status_val == osqp.SolverStatus.OSQP_SIGINT or (flag is not None and flag() != 0)
-    solver_returned(caught)
+    sigint, flag = _osqp()
+    solver_returned(status_val == sigint or (flag is not None and flag() != 0))
 
 
 class _Muted:
