@@ -117,12 +117,20 @@ def test_a_library_build_stops_at_once_and_stores_nothing(tmp_path: Path) -> Non
     assert not (out / "manifest.json").exists()
 
 
-def test_a_closed_pipe_ends_list_quietly() -> None:
+@pytest.mark.parametrize(
+    "command",
+    [
+        ("list",),
+        ("library", "show", "--robot", "cyberdog2", "--board", "skateboard"),
+        ("board", "identify", "--board", "segway"),
+    ],
+)
+def test_a_closed_pipe_ends_the_command_quietly(command: tuple[str, ...]) -> None:
     """``ridempc list | head -1``: the reader gone before the output is written."""
-    process = _start("list")
+    process = _start(*command)
     assert process.stdout is not None
     process.stdout.close()
-    process.wait(timeout=30.0)
+    process.wait(timeout=60.0)
     assert process.stderr is not None
     err = process.stderr.read()
     assert process.returncode == EXIT_CLOSED_PIPE, err
