@@ -304,7 +304,13 @@ def _finish(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    with handled("nothing was written") as handling:
+    """Run one command; its exit code (module docstring).
+
+    Args:
+        argv: The arguments, or None for the program's own (``sys.argv``): the process
+            then ends after the command, and ignores SIGINT and SIGTERM once it is done.
+    """
+    with handled("nothing was written", process_ends=argv is None) as handling:
         try:
             args = _parser().parse_args(argv)
             handling.unwritten = _unwritten(args)

@@ -227,7 +227,7 @@ class _Watchdog:
 
 
 @contextmanager
-def handled(unwritten: str) -> Iterator[Handling]:
+def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
     """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread while a command runs.
 
     A second signal while the command unwinds ends the process at once
@@ -240,6 +240,10 @@ def handled(unwritten: str) -> Iterator[Handling]:
 
     Args:
         unwritten: What an interrupted command leaves incomplete (:class:`Handling`).
+        process_ends: The process ends after the command (the ``ridempc`` program): the
+            signals are then ignored on leaving, also after a command that was not
+            interrupted, rather than given back to Python, whose ``KeyboardInterrupt``
+            would interrupt the interpreter's shutdown with a traceback.
 
     Raises:
         RuntimeError: Not called from the main thread.
@@ -267,11 +271,10 @@ def handled(unwritten: str) -> Iterator[Handling]:
         watchdog.close()
         if handling.received is None:
             _active = outer
-            for s, handler in previous.items():
-                signal.signal(s, handler)
-        else:  # the process is ending (by DEADLINE_S at the latest: the watchdog)
-            for s in SIGNALS:
-                signal.signal(s, signal.SIG_IGN)
+        for s, handler in previous.items():  # after an interrupt the process is ending,
+            if handling.received is not None or process_ends:  # by DEADLINE_S at the latest
+                handler = signal.SIG_IGN
+            signal.signal(s, handler)
 
 
 def _dispatch(signum: int, frame: FrameType | None) -> None:
