@@ -3,13 +3,17 @@
 The command line runs each command inside :func:`handled`: the first SIGINT or SIGTERM
 raises :class:`Interrupted` in the main thread, the command unwinds (its ``finally`` blocks
 remove temporary files) and ``ridempc`` exits with 128 + the signal's number (130, 143)
-after one line on standard error. A further signal while that cleanup runs ends the
-process at once with the same code, one during the interpreter's shutdown is ignored, and
-a process still there ``DEADLINE_S`` after the first signal (its main thread held in
-compiled code, say) is ended by a watchdog thread: never a traceback, always that code.
+after one line on standard error. A further signal ends the process at once with the
+same code, and a process still there ``DEADLINE_S`` after the first signal (its main
+thread held in compiled code, say) is ended then (:class:`_Watcher`, the thread that takes
+the signals): never a traceback, always that code.
 
-Third-party solvers take SIGINT for themselves, and :func:`solver_returned` (or its OSQP
-form, :func:`osqp_returned`) is called after each of their solves to undo it:
+Third-party solvers take SIGINT for themselves. While a command runs the signals are
+blocked in every thread and taken by :class:`_Watcher` with ``sigwait``, so that no
+solver's handler sees them; where a thread was started before (a command run inside
+another program, the tests) and has them unblocked, :func:`solver_returned` (or its OSQP
+form, :func:`osqp_returned`), called after each of the solvers' solves, undoes what
+they did:
 
 - **OSQP** (1.x; the C library in the ``osqp`` package is built with
   ``OSQP_ENABLE_INTERRUPT``) installs its own handler with ``sigaction`` at the start of every
@@ -70,8 +74,12 @@ SIGNALS: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)  # the one
 _SIGACTION_BYTES: int = 512
 # [s] from a signal to the end of a process that has not ended by itself: a ride unwinds and
 # exits in 0.1-0.4 s; closing a --video ride's encoder and snapshots took 0.9 s in all, and
-# the watchdog itself waits for compiled code holding the interpreter's lock to let go.
+# the watcher itself waits for compiled code holding the interpreter's lock to let go.
 DEADLINE_S: float = 0.5
+# Sent to the main thread with the interrupt, to end a wait it is blocked in (a lock, a
+# sleep: the call fails with EINTR and Python runs the tripped handler): a signal whose
+# default action is to be ignored, so a handler of its own changes nothing else.
+_WAKE: signal.Signals = signal.SIGWINCH
 _PR_SET_PDEATHSIG: int = 1  # prctl(2) option: the signal a process gets when its parent dies
 _WORKER_JOIN_S: float = 0.2  # [s] wait for each terminated worker (SIGTERM kills at once)
 _OSQP_INTERRUPTED: str = "Solver interrupted\n"  # what OSQP prints when its handler caught one
@@ -188,55 +196,63 @@ def _open_progress_bar() -> bool:
     return bool(getattr(tqdm, "_instances", None))  # tqdm's set of open bars
 
 
-class _Watchdog:
-    """Ends the process ``DEADLINE_S`` after a signal if the command has not ended by then.
+class _Watcher:
+    """The thread that takes SIGINT and SIGTERM for the process while a command runs.
 
-    Python runs a signal's handler only when the main thread is back in the interpreter;
-    a long call into compiled code (CasADi building an NLP: 7-19 s for a Cassie entry)
-    would hold the interrupt, and the second signal's, until it returns. Python's own C
-    handler writes the signal's number to the wakeup file descriptor at once, also when
-    :func:`solver_returned` passes on one that OSQP caught, and this thread, blocked on
-    the other end of that pipe, needs no more of the interpreter than the compiled call
-    leaves free (CasADi and OSQP release its lock).
+    Both signals are blocked in the main thread before the command starts, so in every
+    thread it starts too (threads inherit the mask), and this thread takes them with
+    ``sigwait``. No handler runs, neither Python's nor one a solver installed (OSQP's), and
+    a signal cannot be lost in a solver's handler. The first one is passed to the main
+    thread (``interrupt_main``: its Python handler raises :class:`Interrupted` as soon as
+    it is back in the interpreter); a second one, or ``DEADLINE_S`` without the process
+    having ended, ends it at once with the same code and line: Python runs handlers only
+    in the main thread, between its bytecodes, so a long call into compiled code (CasADi
+    building an NLP: 7-19 s for a Cassie entry) would otherwise hold the interrupt until it
+    returns. This thread needs no more of the interpreter than such a call leaves free
+    (CasADi and OSQP release its lock).
     """
 
     def __init__(self, handling: Handling) -> None:
         self._handling = handling
-        self._read, self._write = os.pipe()
-        os.set_blocking(self._write, False)  # set_wakeup_fd requires it
-        self._previous = signal.set_wakeup_fd(self._write, warn_on_full_buffer=False)
-        self._thread = threading.Thread(target=self._watch, name="ridempc-interrupts", daemon=True)
+        self._closing = False
+        self._mask = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+        self._thread = threading.Thread(target=self._watch, name="ridempc-signals", daemon=True)
         self._thread.start()
 
     def _watch(self) -> None:
-        byte = os.read(self._read, 1)  # a signal's number, or 0 when the command ended
-        if byte and byte[0] != 0:
+        first = signal.sigwait(SIGNALS)
+        if self._closing:
+            return
+        _thread.interrupt_main(signal.Signals(first))
+        signal.pthread_kill(threading.main_thread().ident or 0, _WAKE)  # out of a wait
+        if hasattr(signal, "sigtimedwait"):
+            signal.sigtimedwait(SIGNALS, DEADLINE_S)  # a second one: at once
+        else:
             time.sleep(DEADLINE_S)
-            self._handling.exit_now(byte[0], None)
+        self._handling.exit_now(first, None)
 
     def close(self) -> None:
-        """Stop watching, unless a signal was received: then the process is ending, and
-        the watchdog ends it at the deadline if it is still there."""
-        if self._handling.received is not None:
+        """Stop watching and unblock the signals, unless one was received: then the
+        process is ending, at ``DEADLINE_S`` at the latest, and later ones end it at once."""
+        if self._handling.received is not None or not self._thread.is_alive():
             return
-        signal.set_wakeup_fd(self._previous)
-        os.write(self._write, b"\0")
+        self._closing = True
+        signal.pthread_kill(self._thread.ident or 0, signal.SIGINT)  # (only it can take it)
         self._thread.join()
-        os.close(self._read)
-        os.close(self._write)
+        signal.pthread_sigmask(signal.SIG_SETMASK, self._mask)
 
 
 @contextmanager
 def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
     """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread while a command runs.
 
-    A second signal while the command unwinds ends the process at once
-    (:meth:`Handling.exit_now`). On leaving, the previous handlers and streams are put
-    back, unless a signal was received: then the process is ending, and further signals are
-    ignored rather than interrupting the interpreter's shutdown with a traceback or, once
-    Python has reset its handlers, killing it with a code other than 130/143. Whatever the
-    main thread is doing, the process ends ``DEADLINE_S`` after the first signal at the
-    latest (:class:`_Watchdog`), with the same code and line.
+    The signals are blocked and taken by :class:`_Watcher`: a second one ends the process
+    at once, and whatever the main thread is doing, the process ends ``DEADLINE_S`` after
+    the first at the latest, with the same code and line. On leaving, the previous handlers
+    and streams are put back and the signals unblocked, unless one was received: then the
+    process is ending, and the watcher keeps them (no ``KeyboardInterrupt`` can interrupt
+    the interpreter's shutdown with a traceback, nor Python's reset of its handlers late in
+    the shutdown let one kill it with a code other than 130/143).
 
     Args:
         unwritten: What an interrupted command leaves incomplete (:class:`Handling`).
@@ -251,11 +267,12 @@ def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
     global _active
     if threading.current_thread() is not threading.main_thread():
         raise RuntimeError("signal handlers can only be installed from the main thread")
-    previous = {s: signal.getsignal(s) for s in SIGNALS}
+    previous = {s: signal.getsignal(s) for s in (*SIGNALS, _WAKE)}
     for s in SIGNALS:
         signal.signal(s, _dispatch)
+    signal.signal(_WAKE, _woken)
     handling = Handling(unwritten)
-    watchdog = _Watchdog(handling)
+    watcher = _Watcher(handling)
     streams = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = _Muted(sys.stdout, handling), _Muted(sys.stderr, handling)
     outer, _active = _active, handling
@@ -268,13 +285,16 @@ def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
                     muted.flush()
         if handling.received is None:  # (else the solvers may still have words to say)
             sys.stdout, sys.stderr = streams
-        watchdog.close()
-        if handling.received is None:
             _active = outer
         for s, handler in previous.items():  # after an interrupt the process is ending,
-            if handling.received is not None or process_ends:  # by DEADLINE_S at the latest
+            if s != _WAKE and (handling.received is not None or process_ends):  # by DEADLINE_S
                 handler = signal.SIG_IGN
             signal.signal(s, handler)
+        watcher.close()  # (unblocks the signals: the handlers are in place by now)
+
+
+def _woken(signum: int, frame: FrameType | None) -> None:
+    """Nothing: the signal only ends the main thread's wait (:data:`_WAKE`)."""
 
 
 def _dispatch(signum: int, frame: FrameType | None) -> None:
@@ -397,9 +417,9 @@ def worker_started() -> None:
     """
     global _active
     _active = None  # a forked copy of the parent's handling is not this process's
-    signal.set_wakeup_fd(-1)  # nor its watchdog's pipe
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)  # blocked in the parent (_Watcher)
     if sys.platform.startswith("linux"):
         _libc().prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
 
