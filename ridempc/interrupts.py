@@ -73,9 +73,10 @@ SIGNALS: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)  # the one
 # Linux x86-64), so the C library never reads or writes past the buffer.
 _SIGACTION_BYTES: int = 512
 # [s] from a signal to the end of a process that has not ended by itself: a ride unwinds and
-# exits in 0.1-0.4 s; closing a --video ride's encoder and snapshots took 0.9 s in all, and
-# the watcher itself waits for compiled code holding the interpreter's lock to let go.
-DEADLINE_S: float = 0.5
+# exits in 0.15-0.35 s (its cleanup in milliseconds, the rest is the interpreter's exit);
+# the watcher itself may wait for the interpreter's lock and, on a loaded machine, for a
+# core (0.33 s past this deadline was seen with two cores and a load of 3.5).
+DEADLINE_S: float = 0.4
 # Sent to the main thread with the interrupt, to end a wait it is blocked in (a lock, a
 # sleep: the call fails with EINTR and Python runs the tripped handler): a signal whose
 # default action is to be ignored, so a handler of its own changes nothing else.
