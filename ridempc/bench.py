@@ -68,6 +68,7 @@ from numpy.typing import NDArray
 
 from ridempc.errors import RidempcError
 from ridempc.heap import frozen_heap
+from ridempc.interrupts import casadi_solve, osqp_returned
 from ridempc.io import atomic_write_json
 
 __all__ = ["PairBench", "bench", "bench_table"]
@@ -278,6 +279,7 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
     for p, a, lower, upper in data:
         qp_osqp = _as_qpsolvers(p, a, lower, upper)
         solution = qpsolvers.solve_problem(qp_osqp, solver="osqp", eps_abs=1e-6, eps_rel=1e-6)
+        osqp_returned(solution.extras["info"].status_val)  # (ridempc.interrupts)
         found = solution.found and solution.x is not None
         reference.append(_objective(p, solution.x) if found else float("nan"))  # type: ignore[arg-type]
     for name in (*OTHER_QP_SOLVERS, "hpipm (casadi)"):
@@ -440,7 +442,8 @@ def _solve_hpipm(
         "ubx": np.clip(ubx, -_HPIPM_INF, _HPIPM_INF),
     }
     started = time.perf_counter()
-    result = solver(**arguments)
+    with casadi_solve():
+        result = solver(**arguments)
     seconds = time.perf_counter() - started
     if not solver.stats().get("success", False):
         return None, seconds

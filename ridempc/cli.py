@@ -2,7 +2,11 @@
 
 Bad input exits with code 2 and one line on standard error naming the bad value and the
 valid ones; a run that fails (diverged physics, a controller error) exits with code 1
-after recording ``status: failed`` in its ``summary.json``.
+after recording ``status: failed`` in its ``summary.json``. SIGINT (Ctrl-C) and SIGTERM
+stop every command within a second, with code 130 or 143 and one line saying what was not
+written (:mod:`ridempc.interrupts`). When the reader of standard output goes away
+(``ridempc list | head -1``), the command ends quietly with code 141, as a Unix tool ended
+by SIGPIPE does.
 """
 
 from __future__ import annotations
@@ -15,12 +19,15 @@ from collections.abc import Sequence
 from ridempc import options
 from ridempc.checks import writable_file
 from ridempc.errors import ConfigError, RidempcError, UnknownNameError
+from ridempc.interrupts import handled
 from ridempc.options import EXIT_BAD_INPUT
+from ridempc.paths import motion_library_dir
 from ridempc.units import MAX_DURATION
 
 __all__ = ["main"]
 
 EXIT_FAILED = 1
+EXIT_CLOSED_PIPE = 141  # 128 + SIGPIPE: what a shell reports for a writer whose reader left
 DURATION_HELP = f"override duration [s], at most {MAX_DURATION:g}"
 OUT_HELP = "output folder; the files an earlier sim or compare wrote there are replaced"
 
@@ -272,29 +279,74 @@ def _sim(args: argparse.Namespace) -> int:
     return EXIT_FAILED if summary["status"] == "failed" else 0
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+def _unwritten(args: argparse.Namespace) -> str:
+    """What the command leaves incomplete when it is interrupted, for its one line."""
+    if args.command == "sim":
+        return f"no summary.json was written in {args.out}"
+    if args.command == "compare":
+        return f"no comparison.json was written in {args.out} (nor the ride under way's summary)"
+    if args.command == "bench":
+        return "no results" + (f" were written to {args.json}" if args.json else " were printed")
+    if args.command == "board":
+        return "no result" + (f" was written to {args.json}" if args.json else " was printed")
+    if args.command == "library" and args.library_command == "build":
+        folder = args.out or motion_library_dir() / f"{args.robot}-{args.board}"
+        return f"the entries under way were not stored in {folder} (the stored ones are complete)"
+    if args.command == "library" and args.plot is not None:
+        return f"no plot was written to {args.plot}"
+    return "nothing was written"
+
+
+def _dispatch(args: argparse.Namespace) -> int:
+    if args.command == "list":
+        return _list()
+    if args.command == "board":
+        return _identify(args)
+    if args.command == "library":
+        return _library(args)
+    if args.command == "compare":
+        return _compare(args)
+    if args.command == "bench":
+        return _bench(args)
+    return _sim(args)
+
+
+def _finish(args: argparse.Namespace) -> int:
+    """The command's exit code: bad input, a failed run and a closed pipe as their codes."""
     try:
-        if args.command == "list":
-            return _list()
-        if args.command == "board":
-            return _identify(args)
-        if args.command == "library":
-            return _library(args)
-        if args.command == "compare":
-            return _compare(args)
-        if args.command == "bench":
-            return _bench(args)
-        return _sim(args)
+        code = _dispatch(args)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's shutdown
+        return code
     except (UnknownNameError, ConfigError) as exc:
         print(f"ridempc: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except RidempcError as exc:
         print(f"ridempc: failed: {exc}", file=sys.stderr)
         return EXIT_FAILED
-    except KeyboardInterrupt:
-        print("ridempc: interrupted; no summary was written", file=sys.stderr)
-        return 130
+    except BrokenPipeError:  # the reader of standard output went away (``| head -1``)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # what is still buffered goes nowhere, quietly
+        os.close(devnull)
+        return EXIT_CLOSED_PIPE
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; its exit code (module docstring).
+
+    Args:
+        argv: The arguments, or None for the program's own (``sys.argv``): the process
+            then ends after the command, and ignores SIGINT and SIGTERM once it is done.
+    """
+    with handled("nothing was written", process_ends=argv is None) as handling:
+        try:
+            args = _parser().parse_args(argv)
+            handling.unwritten = _unwritten(args)
+            code = _finish(args)
+        except BaseException as exc:
+            if handling.received is None and not isinstance(exc, KeyboardInterrupt):
+                raise
+            return handling.report()  # whatever the interrupt raised on its way out
+        return handling.report() if handling.received is not None else code
 
 
 if __name__ == "__main__":

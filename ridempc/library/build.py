@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ridempc.errors import ConfigError, RidempcError
+from ridempc.interrupts import stop_workers, worker_started
 from ridempc.library.format import SUCCESS, EntryRecord
 from ridempc.library.store import library_folder, read_manifest, store_entry, write_manifest
 from ridempc.trajopt.pairs import EntrySpec, Neighbour, load_pair
@@ -214,7 +215,11 @@ def build_library(
     pending = list(specs)
     running: dict[Future[dict[str, Any]], EntrySpec] = {}
     bar = _progress(len(specs), progress)
-    executor: Executor = _Inline() if jobs == 1 else ProcessPoolExecutor(max_workers=jobs)
+    executor: Executor = (
+        _Inline()
+        if jobs == 1
+        else ProcessPoolExecutor(max_workers=jobs, initializer=worker_started)
+    )
 
     def neighbour_of(spec: EntrySpec) -> Neighbour | None:
         same = [n for n in solved.values() if n.metadata.get("kind") == spec.kind]
@@ -252,6 +257,11 @@ def build_library(
                 if bar is not None:
                     bar.set_postfix_str(f"{spec.name}: {result['status']}")
                     bar.update(1)
+    except BaseException:  # an interrupt or an error: the solves under way are not waited for
+        stop_workers(executor)
+        if bar is not None:
+            bar.leave = False  # the command's own line says what happened
+        raise
     finally:
         executor.shutdown(cancel_futures=True)
         if bar is not None:

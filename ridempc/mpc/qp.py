@@ -43,6 +43,7 @@ import osqp
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from ridempc.interrupts import osqp_returned
 from ridempc.mpc.plan import Plan, shift_plan
 from ridempc.mpc.problem import MpcProblem
 
@@ -449,7 +450,12 @@ class MpcQP:
         return StartedSolve(problem, reference, time.perf_counter() - begin)
 
     def run(self) -> SolveOutcome:
-        """OSQP's solve of the started QP (:meth:`start`); never raises."""
+        """OSQP's solve of the started QP (:meth:`start`).
+
+        Raises:
+            Interrupted: In the main thread, when the command was interrupted
+                (:func:`~ridempc.interrupts.osqp_returned`); nothing else.
+        """
         begin = time.perf_counter()
         try:
             result = self._solver.solve(raise_error=False)
@@ -457,6 +463,7 @@ class MpcQP:
             ok = result.info.status_val == _SOLVED
         except (osqp.OSQPException, ValueError) as exc:
             result, status, iterations, ok = None, f"solver error ({exc!r})", 0, False
+        osqp_returned(result.info.status_val if result is not None else _SOLVED)
         return SolveOutcome(result, status, iterations, ok, time.perf_counter() - begin)
 
     def finish(self, started: StartedSolve, outcome: SolveOutcome) -> Plan:

@@ -67,7 +67,7 @@ from __future__ import annotations
 
 import math
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from dataclasses import replace
 from functools import cache
 from typing import Any, NamedTuple
@@ -103,6 +103,7 @@ from ridempc.mpc.qp import SolveOutcome, StartedSolve
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
+from ridempc.mpc.solver_thread import SolverThread
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
@@ -151,11 +152,11 @@ class _PendingSolve(NamedTuple):
 
 
 @cache
-def _solver_thread() -> ThreadPoolExecutor:
+def _solver_thread() -> SolverThread:
     """The thread the MPC's solves run in beside the control loop, one for the process
     (made at its first use): a rider per ride, and rides one after another (``compare``'s
     seeds), would otherwise each leave an idle thread behind."""
-    return ThreadPoolExecutor(max_workers=1, thread_name_prefix="mpc")
+    return SolverThread("mpc")
 
 
 def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:

@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import RidempcError
+from ridempc.interrupts import casadi_solve
 
 __all__ = [
     "NodeSpec",
@@ -386,6 +387,9 @@ def solve_trajectory(
 
     Returns:
         The solution, whatever the status (check ``success``).
+
+    Raises:
+        Interrupted: The command was interrupted (:mod:`ridempc.interrupts`).
     """
     start = time.perf_counter()
     nlp: dict[str, Any] = {"x": problem.variables, "f": problem.objective, "g": problem.constraints}
@@ -407,7 +411,8 @@ def solve_trajectory(
     w0 = problem.pack(initial_states, initial_inputs, initial_midpoints)
     w0 = np.clip(w0, problem.lbw, problem.ubw)
     start = time.perf_counter()
-    result = solver(x0=w0, lbx=problem.lbw, ubx=problem.ubw, lbg=problem.lbg, ubg=problem.ubg)
+    with casadi_solve():  # an interrupt stops IPOPT and is raised again here
+        result = solver(x0=w0, lbx=problem.lbw, ubx=problem.ubw, lbg=problem.lbg, ubg=problem.ubg)
     solve_time = time.perf_counter() - start
     stats = solver.stats()
     states, inputs, midpoints = problem.unpack(np.asarray(result["x"]).ravel())

@@ -22,6 +22,8 @@ import osqp
 import scipy.sparse as sparse
 from numpy.typing import NDArray
 
+from ridempc.interrupts import osqp_returned
+
 __all__ = ["OSQP_INFINITY", "OsqpResult", "OsqpWorkspace"]
 
 Array = NDArray[np.float64]
@@ -94,7 +96,11 @@ class OsqpWorkspace:
         compiled.update_data_mat(P_x=Px, P_i=None, A_x=Ax, A_i=None)
 
     def solve(self) -> OsqpResult:
-        """Solve from the last iterates (warm, if ``warm_starting`` is set)."""
+        """Solve from the last iterates (warm, if ``warm_starting`` is set).
+
+        Raises:
+            Interrupted: The command was interrupted (:mod:`ridempc.interrupts`).
+        """
         compiled = self._compiled
         if compiled is None:
             result = self.wrapper.solve(raise_error=False)
@@ -102,6 +108,7 @@ class OsqpWorkspace:
         else:
             compiled.solve()
             info, x, y = compiled.info, compiled.solution.x, compiled.solution.y
+        osqp_returned(int(info.status_val))
         return OsqpResult(
             x=np.array(x, dtype=float),
             y=np.array(y, dtype=float),
