@@ -12,9 +12,11 @@ by SIGPIPE does.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from ridempc import options
 from ridempc.checks import writable_file
@@ -345,8 +347,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         except BaseException as exc:
             if handling.received is None and not isinstance(exc, KeyboardInterrupt):
                 raise
-            return handling.report()  # whatever the interrupt raised on its way out
-        return handling.report() if handling.received is not None else code
+            code = handling.report()  # whatever the interrupt raised on its way out
+        else:
+            if handling.received is None:
+                return code
+            code = handling.report()
+    if argv is None:
+        _end_now(code)
+    return code
+
+
+def _end_now(code: int) -> NoReturn:
+    """End an interrupted program without the interpreter's shutdown: a solver's thread may
+    still be inside compiled code, and a library's C++ destructors then abort the process
+    (``terminate called without an active exception``, exit -6 instead of 130). Every result
+    is written atomically, so nothing is lost by skipping the shutdown."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):
+            stream.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":
