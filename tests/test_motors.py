@@ -69,7 +69,7 @@ def test_braking_is_limited_as_driving(curve) -> None:
 
 
 def test_cassie_follows_agility_motor_model() -> None:
-    """tlim = 2 tmax (1 - |w| / wmax), clipped to [0, tmax] (cassiemujoco.c, motor())."""
+    """2 peak (1 - |speed| / no-load speed), within [0, peak] (cassie-mujoco-sim's motor model)."""
     curve = TorqueSpeedCurve.of(load_robot("cassie").motors)
     rng = np.random.default_rng(1)
     for _ in range(20):

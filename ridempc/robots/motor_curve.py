@@ -10,9 +10,10 @@ down to none at its no-load speed :math:`\\omega_0`:
 limit depends on the speed's magnitude only, so a torque against the motion (braking) is
 limited as much as one along it, and beyond the no-load speed the motor gives no torque at
 all. That is the motor model of Agility's simulator for Cassie (cassie-mujoco-sim,
-``motor()`` in ``cassiemujoco.c``: ``tlim = 2 tmax (1 - |w| / wmax)`` clipped to
-``[0, tmax]`` whatever the torque's sign, i.e. :math:`f = 1/2`). The gear scales torque and
-speed inversely, so the curve is the same on the motor side and on the joint side.
+``motor()`` in ``cassiemujoco.c``: :math:`\\tau_{lim} = 2 \\tau_{max} (1 - |\\omega| /
+\\omega_{max})` within :math:`[0, \\tau_{max}]`, whatever the command's sign, i.e.
+:math:`f = 1/2`). The gear scales torque and speed inversely, so the curve is the same on
+the motor side and on the joint side.
 """
 
 from __future__ import annotations
