@@ -183,3 +183,25 @@ def test_a_standing_robot_still_stands(robot) -> None:
     assert sim.driver is not None and np.all(sim.driver.delay >= 0)
     # the log carries what the curve allowed next to what the drivers asked for
     assert result.log["motor_available"].shape == result.log["motor_demand"].shape
+
+
+def test_the_wbc_torque_bounds_follow_the_curve(robot) -> None:
+    """The whole-body QP's torque rows: the curve's limits at the motors' present speeds."""
+    from ridempc.wbc.constraints import TorqueSpeedConstraint
+    from ridempc.wbc.model import WholeBodyModel
+
+    model = WholeBodyModel(robot)
+    curve = TorqueSpeedCurve.of(robot.motors)
+    constraint = TorqueSpeedConstraint(model.layout, curve, model.motor_v)
+    rng = np.random.default_rng(2)
+    q = model.pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
+    for _ in range(5):
+        v = rng.normal(size=model.model.nv)
+        v[model.motor_v] = rng.uniform(-1.2, 1.2, curve.peak.size) * curve.no_load_speed
+        terms = model.update(q, v)
+        block = constraint.compute_qp_constraint(terms, None, None)  # rows read no targets
+        limit = curve.limit(v[model.motor_v])
+        assert np.array_equal(block.upper, limit) and np.array_equal(block.lower, -limit)
+        rows, columns = np.nonzero(block.matrix)
+        assert np.array_equal(rows, np.arange(curve.peak.size))
+        assert np.array_equal(columns, model.layout.torque.start + np.arange(curve.peak.size))
