@@ -11,18 +11,22 @@ import argparse
 import os
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 
+from ridempc import options
+from ridempc.checks import writable_file
 from ridempc.errors import ConfigError, RidempcError, UnknownNameError
+from ridempc.options import EXIT_BAD_INPUT
+from ridempc.units import MAX_DURATION
 
 __all__ = ["main"]
 
 EXIT_FAILED = 1
-EXIT_BAD_INPUT = 2
+DURATION_HELP = f"override duration [s], at most {MAX_DURATION:g}"
+OUT_HELP = "output folder; the files an earlier sim or compare wrote there are replaced"
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = options.OneLineParser(
         prog="ridempc", description="Legged robots riding boards in MuJoCo."
     )
     commands = parser.add_subparsers(dest="command", required=True)
@@ -32,16 +36,22 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--board", default="none", help="board name, 'none' = flat ground")
     sim.add_argument("--controller", default="stand", help="controller name (default: stand)")
     sim.add_argument("--scenario", default="stand-still", help="scenario name or .toml file")
-    sim.add_argument("--duration", type=float, default=None, help="override duration [s]")
-    sim.add_argument("--out", type=Path, required=True, help="output folder")
-    sim.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    sim.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
+    sim.add_argument("--out", type=options.path, required=True, help=OUT_HELP)
+    sim.add_argument(
+        "--seed",
+        type=options.bounded_int(0, options.MAX_SEED),
+        default=0,
+        help=f"random seed in [0, {options.MAX_SEED}] (default: 0)",
+    )
     sim.add_argument("--video", action="store_true", help="render video.mp4 offscreen")
     sim.add_argument(
         "--snapshots",
-        type=int,
+        type=options.bounded_int(0, options.MAX_SNAPSHOTS),
         default=0,
         metavar="N",
-        help="write snapshots.png, N frames evenly spaced over the ride (default: none)",
+        help=f"write snapshots.png, N frames evenly spaced over the ride, N <= "
+        f"{options.MAX_SNAPSHOTS} (default: none)",
     )
     sim.add_argument("--no-plots", action="store_true", help="do not write plots.png")
     sim.add_argument("--viewer", action="store_true", help="open MuJoCo's interactive viewer")
@@ -59,12 +69,17 @@ def _parser() -> argparse.ArgumentParser:
     compare.add_argument("--robot", required=True, help="robot name")
     compare.add_argument("--board", required=True, help="board name")
     compare.add_argument("--scenario", required=True, help="scenario name or .toml file")
-    compare.add_argument("--seeds", type=int, default=1, help="seeds 0..N-1 (default: 1)")
+    compare.add_argument(
+        "--seeds",
+        type=options.bounded_int(1, options.MAX_SEEDS),
+        default=1,
+        help=f"seeds 0..N-1, N in [1, {options.MAX_SEEDS}] (default: 1)",
+    )
     compare.add_argument(
         "--controllers", default="pd,mpc", help="comma-separated controllers (default: pd,mpc)"
     )
-    compare.add_argument("--duration", type=float, default=None, help="override duration [s]")
-    compare.add_argument("--out", type=Path, required=True, help="output folder")
+    compare.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
+    compare.add_argument("--out", type=options.path, required=True, help=OUT_HELP)
 
     bench = commands.add_parser(
         "bench", help="MPC and WBC solve times on recorded problems, against other QP solvers"
@@ -74,9 +89,10 @@ def _parser() -> argparse.ArgumentParser:
     )
     bench.add_argument(
         "--seconds",
-        type=float,
+        type=options.positive_seconds,
         default=None,
-        help="simulated seconds recorded per pair (default: 6)",
+        help=f"simulated seconds recorded per pair, at most {options.MAX_BENCH_SECONDS:g} "
+        "(default: 6)",
     )
     bench.add_argument(
         "--scenario",
@@ -89,7 +105,9 @@ def _parser() -> argparse.ArgumentParser:
         default="osqp",
         help="the whole-body QP's solver in the ride and its timing: osqp (default) or daqp",
     )
-    bench.add_argument("--json", type=Path, default=None, help="also write the results here")
+    bench.add_argument(
+        "--json", type=options.path, default=None, help="also write the results here"
+    )
 
     board = commands.add_parser("board", help="board tools")
     board_commands = board.add_subparsers(dest="board_command", required=True)
@@ -97,7 +115,9 @@ def _parser() -> argparse.ArgumentParser:
         "identify", help="identify a board's reduced model from simulated experiments"
     )
     identify.add_argument("--board", required=True, help="board name")
-    identify.add_argument("--json", type=Path, default=None, help="also write the result here")
+    identify.add_argument(
+        "--json", type=options.path, default=None, help="also write the result here"
+    )
 
     library = commands.add_parser("library", help="motion libraries (trajectory optimisation)")
     library_commands = library.add_subparsers(dest="library_command", required=True)
@@ -107,11 +127,18 @@ def _parser() -> argparse.ArgumentParser:
         sub.add_argument("--robot", required=True, help="robot name")
         sub.add_argument("--board", required=True, help="board name")
     build.add_argument("--targets", default=None, help="comma-separated targets, e.g. 0.3,0.5")
-    build.add_argument("--jobs", type=int, default=1, help="worker processes (default: 1)")
-    build.add_argument("--out", type=Path, default=None, help="library folder")
-    show.add_argument("--dir", type=Path, default=None, help="library folder")
-    show.add_argument("--entry", default=None, help="entry name or target, e.g. 0.5")
-    show.add_argument("--plot", type=Path, default=None, help="write a PNG of the entry")
+    build.add_argument(
+        "--jobs",
+        type=options.bounded_int(1, options.MAX_JOBS),
+        default=1,
+        help=f"worker processes, 1 to {options.MAX_JOBS} (default: 1)",
+    )
+    build.add_argument("--out", type=options.path, default=None, help="library folder")
+    show.add_argument("--dir", type=options.path, default=None, help="library folder")
+    show.add_argument(
+        "--entry", type=options.entry_key, default=None, help="entry name or target, e.g. 0.5"
+    )
+    show.add_argument("--plot", type=options.path, default=None, help="write a PNG of the entry")
     return parser
 
 
@@ -121,6 +148,8 @@ def _identify(args: argparse.Namespace) -> int:
     from ridempc.boards import load_board
     from ridempc.io import atomic_write_json
 
+    if args.json is not None:
+        writable_file(args.json, "--json file")
     board = load_board(args.board)
     if board is None:
         raise ConfigError("board 'none' (flat ground) has no reduced model to identify")
@@ -160,11 +189,11 @@ def _compare(args: argparse.Namespace) -> int:
 def _bench(args: argparse.Namespace) -> int:
     from ridempc.bench import DEFAULT_SECONDS, bench
 
+    if args.json is not None:  # checked in the first second of a ten-minute command
+        writable_file(args.json, "--json file")
     if args.seconds is None:
         args.seconds = DEFAULT_SECONDS
-    if not args.seconds > 0.0:
-        raise ConfigError(f"--seconds {args.seconds}: must be positive")
-    pairs = [p.strip() for p in args.pairs.split(",")] if args.pairs else None
+    pairs = None if args.pairs is None else [p.strip() for p in args.pairs.split(",")]
     bench(
         pairs,
         seconds=args.seconds,
@@ -204,8 +233,6 @@ def _sim(args: argparse.Namespace) -> int:
 
     if args.viewer and args.video:
         raise ConfigError("--viewer and --video cannot be used together")
-    if args.snapshots < 0:
-        raise ConfigError(f"--snapshots {args.snapshots}: must be 0 (none) or more")
     if args.viewer and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         print(
             "ridempc: --viewer needs a display and none is available (DISPLAY is not set); "

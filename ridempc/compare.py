@@ -14,7 +14,7 @@ judge's metrics, computed from the true state, never from a controller's view):
 The table is printed and written as ``comparison.md`` and ``comparison.json``; the overlay
 plot ``overlay.png`` shows seed 0 of each controller against the command (forward speed,
 yaw rate, and the deck's roll where a roll is commanded). Files are written atomically, the
-JSON last.
+JSON last; the files of an earlier comparison in the same folder are removed first.
 """
 
 from __future__ import annotations
@@ -26,9 +26,12 @@ from typing import Any
 
 import numpy as np
 
+from ridempc.checks import writable_dir
 from ridempc.errors import ConfigError, UnknownNameError
-from ridempc.io import atomic_write_json, atomic_write_text
-from ridempc.run import RideRequest, ride
+from ridempc.io import atomic_savefig, atomic_write_json, atomic_write_text
+from ridempc.options import MAX_SEEDS
+from ridempc.results import check_clearable, clear_results
+from ridempc.run import RideRequest, check_request, ride
 
 __all__ = ["COMPARED_METRICS", "ComparisonRow", "compare", "comparison_table"]
 
@@ -145,10 +148,10 @@ def _overlay(out: Path, rows: Sequence[ComparisonRow], title: str) -> None:
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
     fig.suptitle(title)
     fig.tight_layout()
-    tmp = out / ".overlay.tmp.png"
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    tmp.replace(out / "overlay.png")
+    try:
+        atomic_savefig(fig, out / "overlay.png", dpi=110)
+    finally:
+        plt.close(fig)
 
 
 def compare(
@@ -161,6 +164,10 @@ def compare(
     duration: float | None = None,
 ) -> list[ComparisonRow]:
     """Ride ``scenario`` with each controller for seeds ``0 .. seeds-1`` and compare.
+
+    Everything is checked before the first ride (the output folder, each controller on the
+    pair, the scenario on its scene); then every file an earlier run wrote in ``out`` is
+    removed (:func:`~ridempc.results.clear_results`), so the folder never mixes two runs.
 
     Args:
         robot: Robot name.
@@ -175,11 +182,14 @@ def compare(
         One row per controller, in the given order.
 
     Raises:
-        ConfigError: Fewer than one seed or two controllers.
+        ConfigError: Seeds out of range, fewer than two controllers, a controller that does
+            not ride the pair, a scenario that does not apply, an unwritable ``out``.
         UnknownNameError: A name that does not exist (before anything runs).
     """
-    if seeds < 1:
-        raise ConfigError(f"--seeds {seeds}: must be at least 1")
+    out = writable_dir(Path(out), "--out folder")
+    check_clearable(out)
+    if not 1 <= seeds <= MAX_SEEDS:
+        raise ConfigError(f"--seeds {seeds}: allowed: a whole number in [1, {MAX_SEEDS}]")
     if len(controllers) < 2 or len(set(controllers)) != len(controllers):
         raise ConfigError(f"compare needs two different controllers, got {list(controllers)}")
     from ridempc.controllers import controller_names
@@ -187,23 +197,27 @@ def compare(
     for controller in controllers:
         if controller not in controller_names():
             raise UnknownNameError("controller", controller, controller_names())
-    out = Path(out)
-    (out / "comparison.json").unlink(missing_ok=True)
+
+    def request(controller: str, seed: int) -> RideRequest:
+        return RideRequest(
+            robot=robot,
+            board=board,
+            controller=controller,
+            scenario=scenario,
+            out=out / controller / f"seed-{seed}",
+            duration=duration,
+            seed=seed,
+            plots=False,
+        )
+
+    for controller in controllers:  # every controller, pair and scenario before any ride
+        check_request(request(controller, 0))
+    clear_results(out)
     rows = []
     for controller in controllers:
         summaries = []
         for seed in range(seeds):
-            request = RideRequest(
-                robot=robot,
-                board=board,
-                controller=controller,
-                scenario=scenario,
-                out=out / controller / f"seed-{seed}",
-                duration=duration,
-                seed=seed,
-                plots=False,
-            )
-            summary = ride(request)
+            summary = ride(request(controller, seed))
             print(
                 f"  {controller} seed {seed}: {summary['status']}"
                 + (f", fell at {summary['fall_time_s']:.2f} s" if summary["fell"] else ""),

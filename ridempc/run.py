@@ -2,29 +2,39 @@
 
 The output folder receives ``log.npz`` (time series), optionally ``video.mp4``,
 ``snapshots.png`` (a strip of still frames) and ``plots.png``, and last of all
-``summary.json``. Every file is written atomically, and a stale ``summary.json`` from an
-earlier run is removed before the new run starts, so an interrupted run never leaves a
-summary that looks complete.
+``summary.json``. Everything is checked before anything is written (:func:`check_request`);
+every file is written atomically, and every file an earlier run wrote there is removed
+before the new run starts (:mod:`ridempc.results`), so a folder never mixes two runs and an
+interrupted run never leaves a summary that looks complete.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ridempc.boards import NO_BOARD, load_board
+from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
-from ridempc.errors import ConfigError
+from ridempc.errors import ConfigError, WriteFailed
 from ridempc.io import atomic_write_json, atomic_write_npz
+from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
-from ridempc.scenarios import resolve_scenario
+from ridempc.scenarios import Scenario, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
+from ridempc.units import MAX_DURATION, MIN_DURATION
 
-__all__ = ["RideRequest", "ride"]
+if TYPE_CHECKING:
+    from ridempc.controllers.base import Controller
+    from ridempc.robots.robot import Robot
+    from ridempc.sim.scene import Scene
+
+__all__ = ["CheckedRide", "RideRequest", "check_request", "ride"]
 
 DEFAULT_SCENARIO = "stand-still"
 
@@ -64,14 +74,59 @@ class RideRequest:
     physics_hz: int = DEFAULT_PHYSICS_HZ
 
 
-def ride(request: RideRequest) -> dict[str, Any]:
-    """Run one ride and write its results; returns the summary.
+@dataclass(frozen=True)
+class CheckedRide:
+    """A request with every name, file and number resolved and checked, its scene built and
+    its simulation set up; nothing written yet.
+
+    Attributes:
+        robot: The robot, or None for a dead weight.
+        board_name: The board's name (``none`` for flat ground).
+        scenario: The scenario, with the request's duration.
+        controller: The controller, or None for a dead weight.
+        scene: The built scene.
+        simulation: The simulation, ready to run.
+        rider_height: Height of the rider's base at the start [m] (frames the cameras).
+        frame_callbacks: Called with (model, data) at the frame rate, when the request
+            renders or views anything; :func:`ride` adds its recorders here.
+        out: The output folder (writable, or creatable).
+    """
+
+    robot: Robot | None
+    board_name: str
+    scenario: Scenario
+    controller: Controller | None
+    scene: Scene
+    simulation: Simulation
+    rider_height: float
+    frame_callbacks: list[Callable[[Any, Any], None]]
+    out: Path
+
+
+def check_request(request: RideRequest) -> CheckedRide:
+    """Check everything a ride needs, before anything is written or simulated.
+
+    The output folder first (in the command's first second), then the numbers, the names,
+    the files, and last what only the built scene can tell (a disturbance's body, the
+    rates): every bad input is found before an earlier run's results are touched.
 
     Raises:
-        UnknownNameError: A name that does not exist (before anything is written).
-        ConfigError: A malformed scenario or parameter file, or a scenario that does not
-            apply to the robot-board pair.
+        UnknownNameError: A name that does not exist.
+        ConfigError: An output folder that cannot be written, a malformed scenario or
+            parameter file, a duration out of range, or a scenario that does not apply to
+            the robot-board pair or its scene.
     """
+    out = writable_dir(Path(request.out), "--out folder")
+    check_clearable(out)
+    if request.duration is not None and not MIN_DURATION <= request.duration <= MAX_DURATION:
+        raise ConfigError(  # NaN fails the comparison too
+            f"--duration {request.duration}: allowed: seconds in "
+            f"[{MIN_DURATION:g}, {MAX_DURATION:g}]"
+        )
+    if request.video:
+        from ridempc.sim.video import require_video_writer
+
+        require_video_writer()
     robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
     board = load_board(request.board)
     board_name = board.name if board is not None else NO_BOARD
@@ -86,14 +141,16 @@ def ride(request: RideRequest) -> dict[str, Any]:
         if board is None:
             raise ConfigError(f"robot '{NO_ROBOT}' (a dead weight) needs a board to ride")
         dead_weight = load_robot(board.params.dead_weight_robot).mass
+    platforms = len(board.params.platform_sites) if board is not None else 0
+    offsets = len(scenario.platform_offsets)
+    if offsets and (platforms < 2 or offsets != platforms):  # only independent ones move
+        raise ConfigError(
+            f"scenario '{scenario.name}': field 'platform_offsets' has {offsets} entries; "
+            f"allowed: none, or one per independent platform (board '{board_name}' has "
+            f"{platforms if platforms > 1 else 'none'})"
+        )
     if request.duration is not None:
-        if request.duration <= 0:
-            raise ConfigError(f"--duration must be positive, got {request.duration}")
         scenario = scenario.with_duration(request.duration)
-
-    out = Path(request.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.json").unlink(missing_ok=True)
 
     scene = build_scene(
         robot,
@@ -103,11 +160,53 @@ def ride(request: RideRequest) -> dict[str, Any]:
         foot_offset=scenario.foot_offset,
         platform_offsets=scenario.platform_offsets,
     )
+    height = float(scene.data.xpos[scene.base_body, 2])
+    frame_callbacks: list[Callable[[Any, Any], None]] = []
+
+    def on_frame(model: Any, data: Any) -> None:
+        for callback in frame_callbacks:
+            callback(model, data)
+
+    framed = request.video or request.viewer or request.snapshots > 0
+    simulation = Simulation(  # checks the scenario against the scene (its bodies)
+        scene,
+        controller,
+        scenario,
+        seed=request.seed,
+        ground_truth=request.ground_truth,
+        on_frame=on_frame if framed else None,
+    )
+    return CheckedRide(
+        robot, board_name, scenario, controller, scene, simulation, height, frame_callbacks, out
+    )
+
+
+def ride(request: RideRequest) -> dict[str, Any]:
+    """Run one ride and write its results; returns the summary.
+
+    Every file an earlier ``sim`` or ``compare`` wrote in the output folder is removed once
+    everything is checked (:func:`check_request`), before the ride starts
+    (:func:`~ridempc.results.clear_results`); nothing else there is touched.
+
+    Raises:
+        UnknownNameError: A name that does not exist (before anything is written).
+        ConfigError: See :func:`check_request` (before anything is written).
+    """
+    checked = check_request(request)
+    robot, board_name, scenario = checked.robot, checked.board_name, checked.scenario
+    controller, scene, simulation = checked.controller, checked.scene, checked.simulation
+    height = checked.rider_height  # frame the rider by its height
+    frame_callbacks = checked.frame_callbacks
+
+    out = checked.out  # nothing is removed or written before this point
+    clear_results(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # the folder changed since it was checked
+        raise WriteFailed(out, exc) from exc
     video = None
     viewer = None
     strip = None
-    frame_callbacks: list[Any] = []
-    height = float(scene.data.xpos[scene.base_body, 2])  # frame the rider by its height
     if request.video:
         from ridempc.sim.video import VideoRecorder
 
@@ -123,7 +222,6 @@ def ride(request: RideRequest) -> dict[str, Any]:
 
         viewer = LiveViewer(scene.model, scene.data)
         frame_callbacks.append(viewer)
-    (out / "snapshots.png").unlink(missing_ok=True)
     if request.snapshots > 0:
         from ridempc.sim.snapshots import SnapshotStrip
 
@@ -137,27 +235,19 @@ def ride(request: RideRequest) -> dict[str, Any]:
         )
         frame_callbacks.append(strip)
 
-    def on_frame(model: Any, data: Any) -> None:
-        for callback in frame_callbacks:
-            callback(model, data)
-
-    simulation = Simulation(
-        scene,
-        controller,
-        scenario,
-        seed=request.seed,
-        ground_truth=request.ground_truth,
-        on_frame=on_frame if frame_callbacks else None,
-    )
+    finished = False
     try:
         result = simulation.run()
+        finished = True
     finally:
         if video is not None:
-            video.close(keep=True)
+            video.close(keep=finished)
         if viewer is not None:
             viewer.close()
-        if strip is not None:
+        if strip is not None and finished:
             strip.close(scene.data)
+        elif strip is not None:
+            strip.discard()
 
     atomic_write_npz(out / "log.npz", result.log)
     files = ["log.npz"]

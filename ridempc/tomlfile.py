@@ -8,6 +8,7 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
+from ridempc.checks import text_file
 from ridempc.errors import ConfigError
 
 __all__ = ["load_checked", "read_toml", "validate"]
@@ -16,12 +17,14 @@ Model = TypeVar("Model", bound=BaseModel)
 
 
 def read_toml(path: Path, what: str) -> dict[str, Any]:
-    """The TOML table in ``path``; ``what`` names the file's role in the error message."""
+    """The TOML table in ``path``; ``what`` names the file's role in the error message.
+
+    Raises:
+        ConfigError: Missing, a folder, unreadable, not UTF-8 or not TOML.
+    """
+    text = text_file(path, what)
     try:
-        with open(path, "rb") as stream:
-            return tomllib.load(stream)
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: {what} not found") from exc
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
 
@@ -31,7 +34,7 @@ def validate(path: Path, raw: dict[str, Any], model: type[Model]) -> Model:
     try:
         return model.model_validate(raw)
     except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+        raise ConfigError.from_validation(path, exc, model) from exc
 
 
 def load_checked(path: Path, model: type[Model], what: str) -> Model:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from ridempc.cli import main
 
 
@@ -31,8 +33,10 @@ def test_compares_two_controllers_over_seeds(tmp_path, capsys) -> None:
 
 def test_bad_input_is_refused_before_anything_runs(tmp_path, capsys) -> None:
     args = ["compare", "--robot", "cyberdog2", "--board", "none", "--scenario", "stand-still"]
-    assert main([*args, "--seeds", "0", "--out", str(tmp_path / "a")]) == 2
-    assert "--seeds 0" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exited:
+        main([*args, "--seeds", "0", "--out", str(tmp_path / "a")])
+    assert exited.value.code == 2
+    assert "--seeds: 0 is out of range" in capsys.readouterr().err
     assert main([*args, "--controllers", "pd", "--out", str(tmp_path / "b")]) == 2
     assert "two different controllers" in capsys.readouterr().err
     assert main([*args, "--controllers", "pd,nope", "--out", str(tmp_path / "c")]) == 2

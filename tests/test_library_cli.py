@@ -12,7 +12,10 @@ from ridempc.library.store import library_folder
 
 
 def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    code = main(list(argv))
+    try:
+        code = main(list(argv))
+    except SystemExit as exc:  # argparse's errors: one line, exit 2
+        code = int(exc.code or 0)
     out, err = capsys.readouterr()
     return code, out, err
 

@@ -160,6 +160,8 @@ def test_non_finite_values_are_refused(library: Path) -> None:
         ),
         (lambda m: m.update(version=7), "field 'version'"),
         (lambda m: m["entries"][0].update(iterations="many"), "iterations"),
+        (lambda m: m["entries"][0]["metadata"].update(mass=float("nan")), "holds NaN"),
+        (lambda m: m["entries"][0].update(dt=float("inf")), "holds Infinity"),
     ],
 )
 def test_bad_manifest_fields_are_refused(library: Path, change, message: str) -> None:

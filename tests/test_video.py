@@ -6,6 +6,7 @@ import json
 
 import imageio_ffmpeg
 import numpy as np
+import pytest
 
 from ridempc.cli import main
 
@@ -40,6 +41,26 @@ def test_snapshot_strip_is_written(tmp_path) -> None:
 
 def test_negative_snapshot_count_is_refused(tmp_path, capsys) -> None:
     out = tmp_path / "bad"
-    assert main(["sim", "--snapshots", "-1", "--out", str(out)]) == 2
-    assert "--snapshots -1" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exited:  # argparse's error, one line
+        main(["sim", "--snapshots", "-1", "--out", str(out)])
+    assert exited.value.code == 2
+    assert "--snapshots: -1 is out of range" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_video_without_its_extra_is_refused_before_the_ride(tmp_path, capsys, monkeypatch) -> None:
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "imageio_ffmpeg" else real(name, *a),
+    )
+    out = tmp_path / "video"
+    code = main(["sim", "--robot", "cyberdog2", "--duration", "0.5", "--video", "--out", str(out)])
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "'video' extra" in err and "pip install" in err
     assert not out.exists()

@@ -14,12 +14,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from ridempc.baselines.cassie_standing_gains import DEFAULT_GAINS_FILE as STANDING_GAINS_FILE
 from ridempc.baselines.cassie_standing_gains import CassieStandingGains
 from ridempc.errors import ConfigError
 from ridempc.tomlfile import read_toml, validate
+from ridempc.units import CheckedModel, NonNegative, Positive, Real
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -31,12 +32,9 @@ __all__ = [
 
 DEFAULT_GAINS_FILE = Path(__file__).with_name("cassie_segway.toml")
 
-NonNegative = Annotated[float, Field(ge=0.0)]
-Positive = Annotated[float, Field(gt=0.0)]
 
-
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """Strict numbers, no NaN, no unknown keys, immutable."""
 
 
 class LoopGains(_Frozen):
@@ -47,14 +45,18 @@ class LoopGains(_Frozen):
     ``max_rate``.
     """
 
-    feedforward: float = Field(description="Shift per unit of command [m per m/s or rad/s].")
-    feedforward_rate: float = Field(
+    # The shift is clamped to max_shift (<= 0.12 m): a feedforward above 1 m per unit of
+    # command would saturate it at an eighth of a unit.
+    feedforward: Annotated[Real, Field(ge=-1.0, le=1.0)] = Field(
+        description="Shift per unit of command [m per m/s or rad/s]."
+    )
+    feedforward_rate: Annotated[Real, Field(ge=-1.0, le=1.0)] = Field(
         description="Shift per unit of the command's rate [m per m/s^2 or rad/s^2]."
     )
     kp: NonNegative = Field(description="Shift per unit of error [m per m/s or rad/s].")
     ki: NonNegative = Field(description="Shift per unit of integrated error [m per m or rad].")
     integral_limit: NonNegative = Field(description="Bound of the integral term [m].")
-    max_shift: Annotated[float, Field(gt=0.0, le=0.12)] = Field(
+    max_shift: Annotated[Real, Field(gt=0.0, le=0.12)] = Field(
         description="Bound of the shift about the standing target [m]."
     )
     max_rate: Positive = Field(description="Fastest change of the shift [m/s].")
@@ -66,7 +68,7 @@ class LoopGains(_Frozen):
 class MountGains(_Frozen):
     """Getting into the riding posture from the stance the ride starts in."""
 
-    spread_time: Annotated[float, Field(ge=0.0, le=5.0)] = Field(
+    spread_time: Annotated[Real, Field(ge=0.0, le=5.0)] = Field(
         description="Time to turn the hip roll to the posture's before crouching [s]."
     )
 

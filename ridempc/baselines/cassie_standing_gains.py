@@ -12,9 +12,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from ridempc.tomlfile import load_checked
+from ridempc.units import CheckedModel, NonNegative, Positive, Real
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -30,27 +31,24 @@ __all__ = [
 
 DEFAULT_GAINS_FILE = Path(__file__).with_name("cassie_standing.toml")
 
-NonNegative = Annotated[float, Field(ge=0.0)]
-Positive = Annotated[float, Field(gt=0.0)]
 
-
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """Strict numbers, no NaN, no unknown keys, immutable."""
 
 
 class Posture(_Frozen):
     """The standing posture; a field left out is read from the first sensor packet."""
 
-    leg_length: Annotated[float, Field(gt=0.3, lt=1.05)] | None = Field(
+    leg_length: Annotated[Real, Field(gt=0.3, lt=1.05)] | None = Field(
         None, description="Mean virtual leg length [m]; sets the standing height."
     )
-    hip_roll: Annotated[float, Field(ge=0.0, le=0.3)] | None = Field(
+    hip_roll: Annotated[Real, Field(ge=0.0, le=0.3)] | None = Field(
         None, description="Outward hip roll of each leg [rad] (+ left, - right)."
     )
-    hip_yaw: Annotated[float, Field(ge=-0.3, le=0.3)] | None = Field(
+    hip_yaw: Annotated[Real, Field(ge=-0.3, le=0.3)] | None = Field(
         None, description="Hip yaw of each leg [rad] (mirrored: + left, - right)."
     )
-    pitch: Annotated[float, Field(ge=-0.5, le=0.5)] = Field(
+    pitch: Annotated[Real, Field(ge=-0.5, le=0.5)] = Field(
         0.0, description="Pelvis pitch target [rad], positive nose down."
     )
 
@@ -61,12 +59,12 @@ class ComXGains(_Frozen):
     :math:`p_x^* = x + k_p (x - x^*) + k_d \\dot x` relative to the support centre.
     """
 
-    target: Annotated[float, Field(ge=-0.08, le=0.08)] = Field(
+    target: Annotated[Real, Field(ge=-0.08, le=0.08)] = Field(
         description="CoM x target relative to the feet's support centre [m]."
     )
     kp: NonNegative = Field(description="CoP lead per metre of CoM error [-].")
     kd: NonNegative = Field(description="CoP lead per m/s of CoM velocity [s].")
-    cop_margin: Annotated[float, Field(ge=0.0, le=0.05)] = Field(
+    cop_margin: Annotated[Real, Field(ge=0.0, le=0.05)] = Field(
         description="The CoP stays this far inside each foot's contact line [m]."
     )
     filter_hz: NonNegative = Field(
@@ -109,8 +107,8 @@ class JointGainSet(_Frozen):
 class LegLimits(_Frozen):
     """Bounds on the commanded virtual leg length and its rate."""
 
-    min_length: Annotated[float, Field(gt=0.3)] = Field(description="[m]")
-    max_length: Annotated[float, Field(lt=1.05)] = Field(description="[m]")
+    min_length: Annotated[Real, Field(gt=0.3)] = Field(description="[m]")
+    max_length: Annotated[Real, Field(lt=1.05)] = Field(description="[m]")
     max_speed: Positive = Field(description="Fastest change of the mean leg length [m/s].")
 
     @model_validator(mode="after")

@@ -14,10 +14,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from ridempc.baselines.cassie_standing_gains import CassieStandingGains
 from ridempc.tomlfile import load_checked
+from ridempc.units import CheckedModel, Flag, NonNegative, Positive, Real
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -33,12 +34,9 @@ __all__ = [
 
 DEFAULT_GAINS_FILE = Path(__file__).with_name("cassie_hovershoes.toml")
 
-NonNegative = Annotated[float, Field(ge=0.0)]
-Positive = Annotated[float, Field(gt=0.0)]
 
-
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """Strict numbers, no NaN, no unknown keys, immutable."""
 
 
 class XAxisGains(_Frozen):
@@ -60,12 +58,12 @@ class YAxisGains(_Frozen):
     """y-axis controller, eq. (14)-(16): each foot's y at +-y_offset by hip yaw."""
 
     kp: NonNegative = Field(description="K_p^y: hip yaw per metre of foot y error [rad/m].")
-    max_hip_yaw: Annotated[float, Field(gt=0.0, le=0.39)] = Field(
+    max_hip_yaw: Annotated[Real, Field(gt=0.0, le=0.39)] = Field(
         description="Bound of the hip-yaw target about the posture [rad] (joint range 0.39)."
     )
     kp_hip_yaw: NonNegative = Field(description="K_p^q2: hip-yaw stiffness [N m/rad].")
     filter_hz: NonNegative = Field(description="Low-pass cut-off on the feet's y [Hz]; 0 = none.")
-    spread_by_hip_roll: bool = Field(
+    spread_by_hip_roll: Flag = Field(
         description="Move the standing hip-roll posture with the commanded y_offset change."
     )
 

@@ -10,9 +10,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from ridempc.tomlfile import load_checked
+from ridempc.units import CheckedModel, NonNegative, Positive, Real
 
 __all__ = [
     "DEFAULT_GAINS_FILE",
@@ -29,30 +30,27 @@ __all__ = [
 
 DEFAULT_GAINS_FILE = Path(__file__).with_name("quadruped_skateboard.toml")
 
-NonNegative = Annotated[float, Field(ge=0.0)]
-Positive = Annotated[float, Field(gt=0.0)]
 
-
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """Strict numbers, no NaN, no unknown keys, immutable."""
 
 
 class Posture(_Frozen):
     """The trunk's pose over the feet; ``height`` left out is held from the first packet."""
 
-    height: Annotated[float, Field(gt=0.1, lt=0.35)] | None = Field(
+    height: Annotated[Real, Field(gt=0.1, lt=0.35)] | None = Field(
         None, description="Trunk origin above the feet's centroid [m]."
     )
-    com_x: Annotated[float, Field(ge=-0.08, le=0.08)] = Field(
+    com_x: Annotated[Real, Field(ge=-0.08, le=0.08)] = Field(
         0.0, description="Centre of mass ahead of the feet's centroid [m]."
     )
-    pitch: Annotated[float, Field(ge=-0.3, le=0.3)] = Field(
+    pitch: Annotated[Real, Field(ge=-0.3, le=0.3)] = Field(
         0.0, description="Trunk pitch, positive nose down [rad]."
     )
-    max_correction: Annotated[float, Field(gt=0.0, le=0.1)] = Field(
+    max_correction: Annotated[Real, Field(gt=0.0, le=0.1)] = Field(
         description="Largest trunk displacement asked for in one tick [m]."
     )
-    max_rotation: Annotated[float, Field(gt=0.0, le=0.5)] = Field(
+    max_rotation: Annotated[Real, Field(gt=0.0, le=0.5)] = Field(
         description="Largest trunk rotation asked for in one tick [rad]."
     )
 
@@ -64,7 +62,7 @@ class RollGains(_Frozen):
     + k_p e + k_d \\dot e + k_i \\textstyle\\int e\\,dt`, :math:`e = \\varphi^* - \\hat\\varphi`.
     """
 
-    feedforward: Annotated[float, Field(ge=0.0, le=2.0)] = Field(
+    feedforward: Annotated[Real, Field(ge=0.0, le=2.0)] = Field(
         description="Scale of the reduced-model feedforward [-] (1 = the identified model)."
     )
     kp: NonNegative = Field(description="Shift per rad of roll error [m/rad].")
@@ -75,7 +73,7 @@ class RollGains(_Frozen):
         description="Deck-mode damping by the feet's load difference, "
         ":math:`\\Delta f_i = -D \\dot{\\hat\\varphi}\\, y_i / \\sum y_j^2` [N m s/rad]."
     )
-    max_shift: Annotated[float, Field(gt=0.0, le=0.1)] = Field(
+    max_shift: Annotated[Real, Field(gt=0.0, le=0.1)] = Field(
         description="Bound of the shift, inside the feet's lateral half-spacing [m]."
     )
     feedback_bandwidth: Positive = Field(
@@ -97,7 +95,7 @@ class SteeringGains(_Frozen):
     """Yaw-rate command to a deck-roll reference by eq. (14), when the board rolls along."""
 
     min_speed: Positive = Field(description="Below this forward speed, no steering [m/s].")
-    max_roll: Annotated[float, Field(gt=0.0, le=0.2)] = Field(
+    max_roll: Annotated[Real, Field(gt=0.0, le=0.2)] = Field(
         description="Bound of the steering roll and of the whole roll reference [rad]."
     )
 
@@ -117,10 +115,10 @@ class JointGainSet(_Frozen):
     abad: JointGains
     hip: JointGains
     knee: JointGains
-    abad_scale_min: Annotated[float, Field(gt=0.0, le=1.0)] = Field(
+    abad_scale_min: Annotated[Real, Field(gt=0.0, le=1.0)] = Field(
         description="Least scale of a leg's abad gains [-]."
     )
-    abad_scale_max: Annotated[float, Field(ge=1.0, le=4.0)] = Field(
+    abad_scale_max: Annotated[Real, Field(ge=1.0, le=4.0)] = Field(
         description="Largest scale of a leg's abad gains [-]."
     )
 
@@ -128,7 +126,7 @@ class JointGainSet(_Frozen):
 class ForceGains(_Frozen):
     """Gravity feedforward: the weight shared by the feet, mapped by :math:`J^\\top`."""
 
-    weight_fraction: Annotated[float, Field(ge=0.0, le=1.2)] = Field(
+    weight_fraction: Annotated[Real, Field(ge=0.0, le=1.2)] = Field(
         description="Fraction of the robot's weight fed forward [-]."
     )
     min_load: NonNegative = Field(description="Floor of each foot's vertical load [N].")

@@ -86,4 +86,25 @@ def load_board_file(path: Path) -> Board:
         raise ConfigError(
             f"{path}: field 'name': is '{params.name}', expected '{path.parent.name}'"
         )
-    return Board(params=params, folder=path.parent)
+    board = Board(params=params, folder=path.parent)
+    _check_names(path, board)
+    return board
+
+
+def _check_names(path: Path, board: Board) -> None:
+    """The sites and bodies the file names exist in the model its figures build."""
+    try:
+        model = board.mj_model
+    except ValueError as exc:
+        raise ConfigError(f"{path}: MuJoCo cannot build the board from it ({exc})") from exc
+    for field, names, kind, count in (
+        ("platform_sites", board.params.platform_sites, mujoco.mjtObj.mjOBJ_SITE, model.nsite),
+        ("ground_bodies", board.params.ground_bodies, mujoco.mjtObj.mjOBJ_BODY, model.nbody),
+    ):
+        valid = [mujoco.mj_id2name(model, kind, i) for i in range(count)]
+        for name in names:
+            if name not in valid:
+                raise ConfigError(
+                    f"{path}: field '{field}': '{name}' is not in the board's model "
+                    f"(valid: {', '.join(v for v in valid if v)})"
+                )

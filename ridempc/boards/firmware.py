@@ -90,6 +90,10 @@ class Firmware(ABC):
         self.io = io
         self.rate_hz = params.firmware_hz
 
+    def reconfigure(self, params: BoardParameters) -> None:
+        """Run on ``params`` from the next tick (a scenario's change of gains or wheel)."""
+        self.params = params
+
     @abstractmethod
     def update(self) -> None:
         """One firmware tick: read the board's sensors, set the board's actuators."""

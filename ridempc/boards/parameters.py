@@ -13,25 +13,45 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from ridempc.tomlfile import read_toml, validate
+from ridempc.units import Angle, CheckedModel, Friction, NonNegative, Positive, Rate, Real
 
 __all__ = [
     "Angle",
     "BoardParameters",
+    "Clearance",
+    "Friction",
+    "GroundSpeed",
+    "Length",
+    "Mass",
+    "MotorSpeed",
     "NonNegative",
     "Positive",
+    "Real",
+    "Torque",
     "read_board_toml",
     "validate_board_parameters",
 ]
 
-Positive = Annotated[float, Field(gt=0.0)]
-NonNegative = Annotated[float, Field(ge=0.0)]
-Angle = Annotated[float, Field(gt=0.0, lt=90.0, description="[deg], in (0, 90)")]
+
+# Upper bounds of a board's figures: each well beyond any rideable board, so that a value
+# past one is a slip of units (millimetres for metres, grams for kilograms), not a board.
+# A board part heavier than 200 kg (a whole Segway miniPro is 13 kg).
+Mass = Annotated[Positive, Field(le=200.0, description="[kg]")]
+# A board dimension beyond 2 m (a longboard's deck is 1.2 m).
+Length = Annotated[Positive, Field(le=2.0, description="[m]")]
+Clearance = Annotated[NonNegative, Field(le=2.0, description="[m]")]
+# A wheel motor above 500 N m (hub motors of personal transporters give tens of N m).
+Torque = Annotated[Positive, Field(le=500.0, description="[N m]")]
+# A ground speed above 20 m/s (personal transporters stop near 6 m/s).
+GroundSpeed = Annotated[Positive, Field(le=20.0, description="[m/s]")]
+# A motor turning faster than 1000 rad/s (10,000 rpm) at the wheel.
+MotorSpeed = Annotated[Positive, Field(le=1000.0, description="[rad/s]")]
 
 
-class BoardParameters(BaseModel):
+class BoardParameters(CheckedModel):
     """What every board states.
 
     Attributes:
@@ -45,11 +65,9 @@ class BoardParameters(BaseModel):
         dead_weight_robot: Robot whose mass the default dead weight has.
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
     name: str = Field(pattern=r"^[a-z0-9][a-z0-9_-]*$")
     kind: str
-    firmware_hz: Positive
+    firmware_hz: Rate
     platform_sites: tuple[str, ...] = Field(min_length=1)
     ground_bodies: tuple[str, ...] = Field(min_length=1)
     dead_weight_robot: str

@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ridempc.checks import readable_dir, writable_dir, writable_file
 from ridempc.errors import ConfigError
 from ridempc.library.build import build_library
 from ridempc.library.format import EntryRecord
@@ -58,7 +59,8 @@ def table(records: list[EntryRecord]) -> str:
 
 
 def library_build(robot: str, board: str, targets: str | None, jobs: int, out: Path | None) -> int:
-    report = build_library(robot, board, parse_targets(targets), jobs=jobs, out=out)
+    folder = writable_dir(out or library_folder(robot, board), "library folder")
+    report = build_library(robot, board, parse_targets(targets), jobs=jobs, out=folder)
     stored = [o.record for o in report.outcomes if o.record is not None]
     if stored:
         print(table(stored))
@@ -95,19 +97,23 @@ def library_show(
     robot: str, board: str, folder: Path | None, entry: str | None, plot: Path | None
 ) -> int:
     pair = load_pair(robot, board)
-    folder = folder or library_folder(robot, board)
+    folder = readable_dir(folder or library_folder(robot, board), "library folder")
+    if plot is not None and entry is None:
+        raise ConfigError("--plot needs --entry (the entry to plot)")
+    if plot is not None:
+        if plot.suffix.lower() != ".png":
+            raise ConfigError(f"--plot {plot}: allowed: a file name ending in .png")
+        writable_file(plot, "--plot file")
     manifest, entries = load_library(folder)
     if (manifest.robot, manifest.board) != (robot, board):
         raise ConfigError(
             f"{folder / 'manifest.json'}: holds {manifest.robot}-{manifest.board}, "
             f"not {robot}-{board}"
         )
+    chosen = None if entry is None else _find(entries, entry, folder)  # before any output
     print(f"{pair.name}: {len(entries)} entries in {folder} (all hashes and arrays verified)")
     print(table([e.record for e in entries]))
-    if plot is not None and entry is None:
-        raise ConfigError("--plot needs --entry (the entry to plot)")
-    if entry is not None:
-        chosen = _find(entries, entry, folder)
+    if chosen is not None:
         r = chosen.record
         print(
             f"{r.name}: {r.n_intervals} intervals of {r.dt} s; drift: local {r.drift.local:.1e}, "

@@ -27,9 +27,19 @@ refuses anything else with a :class:`~ridempc.errors.ConfigError` naming the fil
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, NonNegativeFloat, NonNegativeInt, PositiveInt
+from pydantic import Field
+
+from ridempc.units import (
+    CheckedModel,
+    Count,
+    NonNegative,
+    NonNegativeCount,
+    Positive,
+    PositiveCount,
+    Real,
+)
 
 __all__ = [
     "ARRAYS",
@@ -61,18 +71,18 @@ ARRAYS: dict[str, tuple[str, tuple[str, ...]]] = {
 NAME_PATTERN = r"^[a-z][a-z0-9_]*-[0-9]+\.[0-9]{2}$"
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Strict(CheckedModel):
+    """Strict numbers (no NaN, no strings or booleans for numbers), no unknown keys."""
 
 
 class DriftRecord(_Strict):
     """Re-simulation drift (see :mod:`ridempc.trajopt.validation`), state units."""
 
-    local: NonNegativeFloat = Field(description="largest one-interval gap, every state")
-    local_board: NonNegativeFloat = Field(description="largest one-interval gap, board states")
-    board: NonNegativeFloat = Field(description="largest gap of the board-only rollout")
-    board_final: dict[str, NonNegativeFloat]
-    open_loop_time: NonNegativeFloat = Field(description="[s] open loop within tolerance")
+    local: NonNegative = Field(description="largest one-interval gap, every state")
+    local_board: NonNegative = Field(description="largest one-interval gap, board states")
+    board: NonNegative = Field(description="largest gap of the board-only rollout")
+    board_final: dict[str, NonNegative]
+    open_loop_time: NonNegative = Field(description="[s] open loop within tolerance")
     integrator: str
 
 
@@ -81,19 +91,19 @@ class EntryRecord(_Strict):
 
     name: str = Field(pattern=NAME_PATTERN)
     kind: str = Field(pattern=r"^[a-z][a-z0-9_]*$")
-    target: float
+    target: Annotated[Real, Field(gt=0.0, le=10.0)]  # [m/s]; every pair checks its own bound
     file: str = Field(description="the entry's file, always '<name>.npz'")
     sha256: str = Field(pattern=r"^[0-9a-f]{64}$")
     status: Literal["Solve_Succeeded"]
-    iterations: NonNegativeInt
-    solve_time_s: NonNegativeFloat
-    build_time_s: NonNegativeFloat
-    max_violation: NonNegativeFloat
-    n_intervals: PositiveInt
-    dt: float = Field(gt=0.0)
-    nx: PositiveInt
-    nu: PositiveInt
-    n_parameters: NonNegativeInt
+    iterations: NonNegativeCount
+    solve_time_s: NonNegative
+    build_time_s: NonNegative
+    max_violation: NonNegative
+    n_intervals: PositiveCount
+    dt: Annotated[Positive, Field(le=1.0)]  # [s]; a collocation step above 1 s resolves nothing
+    nx: PositiveCount
+    nu: PositiveCount
+    n_parameters: NonNegativeCount
     drift: DriftRecord
     warm_start: str | None
     metadata: dict[str, Any]
@@ -114,7 +124,7 @@ class Manifest(_Strict):
     """``manifest.json`` of one robot-board pair."""
 
     format: Literal["ridempc-motion-library"]
-    version: Literal[1]
+    version: Annotated[Count, Field(ge=VERSION, le=VERSION)]  # the only version there is
     robot: str
     board: str
     entries: tuple[EntryRecord, ...]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ridempc.io import atomic_savefig
 from ridempc.library.store import LibraryEntry
 
 __all__ = ["plot_entry"]
@@ -50,7 +51,7 @@ def plot_entry(entry: LibraryEntry, path: Path, title: str) -> None:
         f"{r.solve_time_s:.1f} s IPOPT, max defect {r.max_violation:.1e}"
     )
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        atomic_savefig(fig, Path(path), dpi=110)
+    finally:
+        plt.close(fig)

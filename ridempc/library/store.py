@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import ValidationError
 
+from ridempc.checks import readable_file, text_file
 from ridempc.errors import ConfigError
 from ridempc.io import atomic_write, atomic_write_json
 from ridempc.library.format import ARRAYS, FORMAT, MANIFEST, VERSION, EntryRecord, Manifest
@@ -138,16 +139,21 @@ def read_manifest(folder: Path) -> Manifest:
         ConfigError: Missing, not JSON, or a field missing or wrong (the field is named).
     """
     path = folder / MANIFEST
+    if not path.exists() and not path.is_symlink():
+        raise ConfigError(f"{path}: no motion library here (manifest.json not found)")
+    text = text_file(path, "motion-library manifest")
+
+    def refuse(constant: str) -> None:  # JSON has no NaN or Infinity; Python's reader takes them
+        raise ConfigError(f"{path}: holds {constant}; allowed: finite numbers only")
+
     try:
-        raw = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: no motion library here (manifest.json not found)") from exc
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raw = json.loads(text, parse_constant=refuse)
+    except json.JSONDecodeError as exc:
         raise ConfigError(f"{path}: not valid JSON ({exc})") from exc
     try:
         manifest = Manifest.model_validate(raw)
     except ValidationError as exc:
-        raise ConfigError.from_validation(path, exc) from exc
+        raise ConfigError.from_validation(path, exc, Manifest) from exc
     names = [e.name for e in manifest.entries]
     for entry in manifest.entries:
         if entry.file != f"{entry.name}.npz":
@@ -192,11 +198,11 @@ def load_entry(folder: Path, record: EntryRecord) -> LibraryEntry:
         ConfigError: Missing file, hash mismatch, not an ``.npz`` of plain arrays, or an
             array missing or of the wrong dtype, shape or values; the file is named.
     """
-    path = folder / record.file
+    path = readable_file(folder / record.file, "entry file")
     try:
         data = path.read_bytes()
-    except FileNotFoundError as exc:
-        raise ConfigError(f"{path}: entry file not found") from exc
+    except OSError as exc:
+        raise ConfigError(f"{path}: entry file is not readable ({exc.strerror})") from exc
     digest = hashlib.sha256(data).hexdigest()
     if digest != record.sha256:
         raise ConfigError(

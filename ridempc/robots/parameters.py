@@ -14,20 +14,20 @@ A second robot of a class is a new folder with these two files, never new code.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from ridempc.tomlfile import load_checked
+from ridempc.units import CheckedModel, NonNegative, Positive, Real
 
 __all__ = ["MotorParameters", "RobotParameters", "load_robot_parameters"]
 
-PositiveFloat = Annotated[float, Field(gt=0.0)]
-NonNegativeFloat = Annotated[float, Field(ge=0.0)]
+PositiveFloat = Positive
+NonNegativeFloat = NonNegative
 
 
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """Strict numbers, no NaN, no unknown keys, immutable."""
 
 
 class MotorParameters(_Frozen):
@@ -91,12 +91,13 @@ class RobotParameters(_Frozen):
         ),
     )
     fall_height: PositiveFloat = Field(
-        description="Base origin below this height over its support = fall [m]."
+        le=3.0,  # no legged robot's base stands 3 m high
+        description="Base origin below this height over its support = fall [m].",
     )
     motors: dict[str, MotorParameters] = Field(
         min_length=1, description="Per motor, keyed by actuator name."
     )
-    tracking_gain_scale: float = Field(
+    tracking_gain_scale: Real = Field(
         default=1.0,
         gt=0.0,
         le=1.0,
@@ -105,16 +106,17 @@ class RobotParameters(_Frozen):
             "controller whose torques go out as feedforward (the MPC rider) [-]."
         ),
     )
-    wbc_force_weight: float = Field(
+    wbc_force_weight: Real = Field(
         default=100.0,
         gt=0.0,
+        le=1e6,  # beyond it the QP's other tasks vanish below OSQP's tolerances
         description=(
             "Weight of the MPC's contact forces in the MPC rider's whole-body QP, per unit "
             "of whole-body acceleration [(kg/N)^2] (WbcSettings.force_weight)."
         ),
     )
 
-    wbc_feedforward: float = Field(
+    wbc_feedforward: Real = Field(
         default=0.0,
         ge=0.0,
         le=1.0,

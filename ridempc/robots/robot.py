@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.checks import readable_file
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.paths import robots_dir
 from ridempc.robots.parameters import RobotParameters, load_robot_parameters
@@ -179,4 +180,5 @@ def load_robot(name: str) -> Robot:
         raise ConfigError(
             f"{folder / 'robot.toml'}: field 'name': is '{params.name}', expected '{name}'"
         )
+    readable_file(folder / params.description, "robot description (MJCF)")
     return Robot(params=params, folder=folder)

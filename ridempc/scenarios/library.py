@@ -33,9 +33,10 @@ def resolve_scenario(name_or_path: str, board: str | None = None) -> Scenario:
 
     Raises:
         UnknownNameError: Not a library name and not a ``.toml`` path.
-        ConfigError: The file is malformed, or the name has no variant for ``board``.
+        ConfigError: A path that is missing, not a readable UTF-8 file or malformed, or a
+            name with no variant for ``board``.
     """
-    if name_or_path.endswith(".toml") or "/" in name_or_path:
+    if name_or_path.lower().endswith(".toml") or "/" in name_or_path:  # a path, not a name
         return load_scenario_file(Path(name_or_path))
     if name_or_path not in scenario_names():
         raise UnknownNameError("scenario", name_or_path, scenario_names())

@@ -21,10 +21,32 @@ non-physical values are refused with the field named). Example::
     [noise]                    # sensor noise overrides, see SensorNoise
     vio_latency = 0.05
 
-    [[changes]]
-    t = 5.0
+    [[changes]]                # one knob of ridempc.sim.knobs.KNOBS each
+    t = 5.0                    # [s]; 0 (the default): before the first physics step
     parameter = "floor_friction"
-    value = 0.6
+    value = 0.3                # [-], in (0, 3]
+
+    [[changes]]
+    parameter = "board_mass"
+    body = "left_shoe"         # a body of the board
+    scale = 1.3                # times the nominal mass; exactly one of value, scale
+
+    [[changes]]
+    parameter = "payload"
+    body = "base"              # "base", or a body of the robot
+    mass = 5.0                 # [kg]
+    offset = [0.0, 0.0, 0.1]   # in the body's frame [m]
+
+    [[changes]]
+    parameter = "firmware_gain"
+    gain = "pitch_kp"          # Hovershoes: pitch_kp, pitch_kd, tilt_back_gain; Segway: [gains]
+    scale = 0.8
+
+The other knobs: ``tyre_friction``, ``deck_friction`` [-], ``wheel_radius`` [m],
+``bushing_stiffness`` [N m/rad] and ``bushing_damping`` [N m s/rad] (skateboard),
+``base_payload`` [kg], ``motor_torque_limit`` (scale only) and ``joint_damping``
+[N m s/rad] (``joint``, default all); units, ranges and how each applies are in
+:mod:`ridempc.sim.knobs`.
 """
 
 from __future__ import annotations
@@ -35,10 +57,12 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
+from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
+from ridempc.units import MAX_DURATION, CheckedModel, Duration, Flag, Real, RideDuration, Time
 
 __all__ = [
     "Command",
@@ -52,12 +76,24 @@ __all__ = [
     "load_scenario_file",
 ]
 
-Time = Annotated[float, Field(ge=0.0, description="[s]")]
-Vector3 = tuple[float, float, float]
+# Command bounds: beyond what any board carries a rider at (the Segway's 4.44 m/s top speed,
+# a spin of 2 turns a second, a stance change of half a metre, the skateboard's 0.5 rad roll
+# limit), so a value outside them is a typo, not an experiment.
+Velocity = Annotated[Real, Field(ge=-10.0, le=10.0, description="[m/s]")]
+YawRate = Annotated[Real, Field(ge=-4.0 * math.pi, le=4.0 * math.pi, description="[rad/s]")]
+LateralOffset = Annotated[Real, Field(ge=-0.5, le=0.5, description="[m]")]
+Roll = Annotated[Real, Field(ge=-0.5, le=0.5, description="[rad]")]
+# A push or kick: 10 kN (or 100 N/kg, ten g) throws any of the robots; more is a typo.
+Force = Annotated[Real, Field(ge=-10_000.0, le=10_000.0, description="[N] or [N/kg]")]
+Torque = Annotated[Real, Field(ge=-2_000.0, le=2_000.0, description="[N m] or [N m/kg]")]
+# A foot or platform moved by more than half a metre is off any deck.
+Offset = Annotated[Real, Field(ge=-0.5, le=0.5, description="[m]")]
+Vector3 = tuple[Force, Force, Force]
+TorqueVector = tuple[Torque, Torque, Torque]
 
 
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """The scenario's models: strict numbers, no NaN, no unknown keys, immutable."""
 
 
 class Command(_Frozen):
@@ -72,10 +108,10 @@ class Command(_Frozen):
         roll: Board roll reference [rad].
     """
 
-    velocity: float = 0.0
-    yaw_rate: float = 0.0
-    lateral_offset: float = 0.0
-    roll: float = 0.0
+    velocity: Velocity = 0.0
+    yaw_rate: YawRate = 0.0
+    lateral_offset: LateralOffset = 0.0
+    roll: Roll = 0.0
 
 
 _COMMAND_DEFAULTS: MappingProxyType[str, float] = MappingProxyType(Command().model_dump())
@@ -85,11 +121,11 @@ class CommandEvent(_Frozen):
     """From time ``t``, set the given command fields (ramped over ``ramp`` seconds)."""
 
     t: Time
-    ramp: Annotated[float, Field(ge=0.0)] = 0.0
-    velocity: float | None = None
-    yaw_rate: float | None = None
-    lateral_offset: float | None = None
-    roll: float | None = None
+    ramp: Annotated[Time, Field(description="[s]")] = 0.0
+    velocity: Velocity | None = None
+    yaw_rate: YawRate | None = None
+    lateral_offset: LateralOffset | None = None
+    roll: Roll | None = None
 
     def fields(self) -> dict[str, float]:
         return dict(self._fields)
@@ -107,10 +143,10 @@ class CommandWave(_Frozen):
     :math:`a \sin(2\pi (t - t_0) / T)` (the skateboard's roll reference, the wave pattern)."""
 
     field: Literal["velocity", "yaw_rate", "lateral_offset", "roll"]
-    amplitude: float
-    period: Annotated[float, Field(gt=0.0)]  # [s]
+    amplitude: Annotated[Real, Field(ge=-10.0, le=10.0)]  # the field's unit; the widest bound
+    period: Duration
     start: Time = 0.0
-    stop: Annotated[float, Field(gt=0.0)] = 3600.0  # [s]
+    stop: Duration = MAX_DURATION
 
     def value(self, t: float) -> float:
         if not self.start <= t < self.stop:
@@ -124,17 +160,85 @@ class Disturbance(_Frozen):
     t: Time
     body: str = "base"
     force: Vector3 = (0.0, 0.0, 0.0)  # world frame [N]
-    torque: Vector3 = (0.0, 0.0, 0.0)  # world frame [N m]
-    duration: Annotated[float, Field(gt=0.0, le=5.0)] = 0.1  # [s]
-    per_kg: bool = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
+    torque: TorqueVector = (0.0, 0.0, 0.0)  # world frame [N m]
+    duration: Annotated[Real, Field(gt=0.0, le=5.0)] = 0.1  # [s]; a longer one is a load
+    per_kg: Flag = False  # force and torque are per kg of the robot's mass [N/kg], [N m/kg]
 
 
 class ParameterChange(_Frozen):
-    """A change of a physical parameter during the run."""
+    """A change of a physical parameter at time ``t``: one knob of
+    :data:`ridempc.sim.knobs.KNOBS`, set to ``value`` or to ``scale`` times its nominal
+    value (exactly one of them; ``payload`` takes ``mass`` and ``offset`` instead).
 
-    t: Time
-    parameter: Literal["floor_friction", "base_payload"]  # [-] / [kg] added to the base
-    value: float
+    Attributes:
+        t: When it takes effect [s] (0: before the first physics step).
+        parameter: The knob's name.
+        value: The new value [the knob's unit].
+        scale: The new value over the nominal one [-].
+        body: Where a ``board_mass`` (a board body) or ``payload`` (a rider body, ``base``
+            for the base) applies.
+        gain: Which firmware gain ``firmware_gain`` sets.
+        joint: The one robot joint ``joint_damping`` sets (default: all of them).
+        mass: The payload's mass [kg].
+        offset: The payload's position in the body's frame [m].
+    """
+
+    t: Time = 0.0
+    parameter: str
+    value: Real | None = None
+    scale: Real | None = None
+    body: str | None = None
+    gain: str | None = None
+    joint: str | None = None
+    mass: Real | None = None
+    offset: tuple[Real, Real, Real] | None = None
+
+    @field_validator("parameter")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if name not in KNOBS:
+            raise ValueError(f"unknown knob '{name}' (valid: {', '.join(sorted(KNOBS))})")
+        return name
+
+    @model_validator(mode="after")
+    def _in_range(self) -> ParameterChange:
+        knob = KNOBS[self.parameter]
+        given = [f for f in ("value", "scale") if getattr(self, f) is not None]
+        if knob.forms and len(given) != 1:
+            raise ValueError(
+                f"{self.parameter} takes exactly one of "
+                f"{' or '.join(f for f in ('value', 'scale') if f in knob.forms)}"
+            )
+        for form in given:
+            if form not in knob.forms:
+                raise ValueError(f"{self.parameter} takes no {form}")
+        if self.value is not None and not knob.admits(self.value):
+            raise ValueError(f"{self.parameter} value = {self.value} is outside {knob.allowed()}")
+        if self.scale is not None and not (
+            0.0 < self.scale <= SCALE_MAX and (knob.forms != {"scale"} or knob.admits(self.scale))
+        ):
+            top = knob.high if knob.forms == {"scale"} else SCALE_MAX
+            raise ValueError(f"{self.parameter} scale = {self.scale} is outside (0, {top:g}]")
+        for name in ("body", "gain", "joint"):
+            if getattr(self, name) is not None and knob.where != name:
+                raise ValueError(f"{self.parameter} takes no {name}")
+        if knob.where is not None and knob.where_required and getattr(self, knob.where) is None:
+            raise ValueError(f"{self.parameter} needs a {knob.where}")
+        payload = self.parameter == "payload"
+        if not payload and (self.mass is not None or self.offset is not None):
+            raise ValueError(f"{self.parameter} takes no mass or offset (a payload does)")
+        if payload:
+            if self.mass is None:
+                raise ValueError(f"payload needs a mass in {knob.allowed()}")
+            if not knob.admits(self.mass):
+                raise ValueError(f"payload mass = {self.mass} is outside {knob.allowed()}")
+            offset = self.offset or (0.0, 0.0, 0.0)
+            if not all(math.isfinite(x) and abs(x) <= PAYLOAD_OFFSET_MAX for x in offset):
+                raise ValueError(
+                    f"payload offset = {list(offset)} is outside [-{PAYLOAD_OFFSET_MAX:g}, "
+                    f"{PAYLOAD_OFFSET_MAX:g}] m per axis"
+                )
+        return self
 
 
 class PushOff(_Frozen):
@@ -145,7 +249,7 @@ class PushOff(_Frozen):
     ``judged_at``, the end of the push-off (a rolling board slows afterwards).
     """
 
-    target: Annotated[float, Field(gt=0.0)]  # [m/s]
+    target: Annotated[Real, Field(gt=0.0, le=10.0)]  # [m/s], at most a command's speed
     judged_at: Time  # [s]
 
 
@@ -157,12 +261,12 @@ class Scenario(_Frozen):
 
     name: str = Field(pattern=r"^[a-z0-9][a-z0-9._-]*$")
     description: str = ""
-    duration: Annotated[float, Field(gt=0.0, le=3600.0)]  # [s]
+    duration: RideDuration
     robots: tuple[str, ...] = ()  # robots it applies to; empty means any
     boards: tuple[str, ...] = ()  # boards it applies to; empty means any
     metrics_start: Time = 0.0  # tracking errors are measured from this time on [s]
-    foot_offset: tuple[float, float] = (0.0, 0.0)  # feet off the platform centre, (x, y) [m]
-    platform_offsets: tuple[tuple[float, float], ...] = ()  # independent platforms moved [m]
+    foot_offset: tuple[Offset, Offset] = (0.0, 0.0)  # feet off the platform centre, (x, y) [m]
+    platform_offsets: tuple[tuple[Offset, Offset], ...] = ()  # independent platforms moved [m]
     commands: tuple[CommandEvent, ...] = ()
     waves: tuple[CommandWave, ...] = ()
     disturbances: tuple[Disturbance, ...] = ()
@@ -175,6 +279,25 @@ class Scenario(_Frozen):
         times = [c.t for c in self.commands]
         if times != sorted(times):
             raise ValueError("commands must be in time order")
+        for i, wave in enumerate(self.waves):
+            if wave.stop <= wave.start:
+                raise ValueError(f"waves.{i}: stop ({wave.stop} s) must come after start")
+        return self
+
+    @model_validator(mode="after")
+    def _within_the_ride(self) -> Scenario:
+        """An event after the end would never happen: a mistake, not a no-op to ignore."""
+        times = [("metrics_start", self.metrics_start)]
+        times += [(f"commands.{i}.t", c.t) for i, c in enumerate(self.commands)]
+        times += [(f"waves.{i}.start", w.start) for i, w in enumerate(self.waves)]
+        times += [(f"disturbances.{i}.t", d.t) for i, d in enumerate(self.disturbances)]
+        if self.push_off is not None:
+            times.append(("push_off.judged_at", self.push_off.judged_at))
+        for where, t in times:
+            if t > self.duration or (where == "metrics_start" and t >= self.duration):
+                raise ValueError(
+                    f"{where} = {t} s is after the end of the ride (duration {self.duration} s)"
+                )
         return self
 
     def applies_to(self, robot: str, board: str) -> bool:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ridempc.io import atomic_savefig
 from ridempc.robots.robot import Robot
 
 __all__ = ["plot_run"]
@@ -67,11 +68,10 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title:
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(title)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    fig.savefig(tmp, dpi=90)
-    plt.close(fig)
-    tmp.replace(path)
+    try:
+        atomic_savefig(fig, path, dpi=90)
+    finally:
+        plt.close(fig)
 
 
 def _plot_estimate(ax, t: np.ndarray, log: dict[str, np.ndarray]) -> None:

@@ -3,7 +3,9 @@
 The robot's MJCF stays untouched on disk; the scene builder edits a copy of its spec to
 add the floor, light, the IMU's MuJoCo sensors and the physics options, and places the
 robot in its standing keyframe with its lowest foot point ``FOOT_CLEARANCE`` above the
-support, so the run starts settled (no interpenetration, no launch).
+support, so the run starts settled (no interpenetration, no launch). The floor's and the
+decks' contacts are explicit pairs (:mod:`ridempc.sim.contact_pairs`), so that a scenario
+can change their friction.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from ridempc.boards.board import Board
 from ridempc.errors import ConfigError
 from ridempc.mjcf import STIFF_CONTACT, add_imu_sensors
 from ridempc.robots.robot import Robot
+from ridempc.sim.contact_pairs import add_surface_pairs, collision_geoms
 
 __all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
 
@@ -55,6 +58,7 @@ class Scene:
         board_roots: Board bodies carrying a free joint (one per independent platform).
         board_ground_bodies: Board bodies allowed to touch the ground (wheels).
         ground_geoms: Geom ids of the ground.
+        deck_geoms: Collision geom ids of the board's platforms (where the rider stands).
         support_height: Height of the rider's support at the start [m] (platform top or 0).
         initial_qpos: The settled initial configuration.
     """
@@ -77,6 +81,7 @@ class Scene:
     ground_geoms: frozenset[int]
     support_height: float
     initial_qpos: NDArray[np.float64]
+    deck_geoms: frozenset[int] = frozenset()
 
     def reset(self) -> None:
         mujoco.mj_resetData(self.model, self.data)
@@ -235,6 +240,9 @@ def build_scene(
     if board is not None:
         spec.attach(board.spec(), prefix=BOARD_PREFIX, frame=spec.worldbody.add_frame())
     model = spec.compile()
+    floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+    decks = _deck_geoms(model, board)
+    model = add_surface_pairs(spec, model, [floor, *decks])  # for friction changes
     data = mujoco.MjData(model)
 
     def body(name: str) -> int:
@@ -323,7 +331,6 @@ def build_scene(
         data.qpos[:] = qpos
         mujoco.mj_kinematics(model, data)
         _check_feet_over(model, data, robot, board, frozenset(board_bodies))
-    floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
     scene = Scene(
         model=model,
         data=data,
@@ -341,11 +348,24 @@ def build_scene(
         board_roots=board_roots,
         board_ground_bodies=board_ground,
         ground_geoms=frozenset({floor}),
+        deck_geoms=frozenset(decks),
         support_height=support,
         initial_qpos=qpos,
     )
     scene.reset()
     return scene
+
+
+def _deck_geoms(model: mujoco.MjModel, board: Board | None) -> list[int]:
+    """Collision geoms of the bodies carrying the board's platform sites."""
+    if board is None:
+        return []
+    sites = [
+        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, BOARD_PREFIX + n)
+        for n in board.params.platform_sites
+    ]
+    bodies = {int(model.site_bodyid[s]) for s in sites if s >= 0}  # a missing one: refused later
+    return sorted(collision_geoms(model, bodies))
 
 
 def _check_feet_over(

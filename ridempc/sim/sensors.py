@@ -24,36 +24,45 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
+from typing import Annotated
 
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from ridempc.units import CheckedModel, Real
 
 __all__ = ["GroundTruth", "ImuReading", "SensorNoise", "SensorPacket", "SensorSuite", "VioReading"]
 
 Array = NDArray[np.float64]
 
 
-class SensorNoise(BaseModel):
+# Upper bounds of the noise figures: at them a reading says nothing (a 0.5 rad tilt, a 1 m
+# position error), so a larger figure is a slip of units (degrees for radians), not a sensor.
+_Std = Annotated[Real, Field(ge=0.0)]
+
+
+class SensorNoise(CheckedModel):
     """Noise, resolution and latency of the rider's sensors (scenario ``[noise]`` table)."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
-    imu_orientation_std: float = Field(0.002, ge=0, description="[rad] per axis")
-    imu_gyro_std: float = Field(0.005, ge=0, description="[rad/s]")
-    imu_accel_std: float = Field(0.05, ge=0, description="[m/s^2]")
-    encoder_resolution: float = Field(
-        2 * np.pi / 2**14, ge=0, description="[rad] quantisation step (14-bit)"
+    imu_orientation_std: Annotated[_Std, Field(le=0.5)] = Field(0.002, description="[rad] per axis")
+    imu_gyro_std: Annotated[_Std, Field(le=5.0)] = Field(0.005, description="[rad/s]")
+    imu_accel_std: Annotated[_Std, Field(le=50.0)] = Field(0.05, description="[m/s^2]")
+    encoder_resolution: Annotated[_Std, Field(le=0.5)] = Field(
+        2 * np.pi / 2**14, description="[rad] quantisation step (14-bit)"
     )
-    encoder_velocity_std: float = Field(0.01, ge=0, description="[rad/s]")
-    torque_std: float = Field(0.05, ge=0, description="[N m]")
-    vio_hz: float = Field(30.0, gt=0, description="[Hz] VIO sample rate")
-    vio_latency: float = Field(0.03, ge=0, le=1.0, description="[s] capture-to-delivery delay")
-    vio_position_std: float = Field(0.01, ge=0, description="[m]")
-    vio_yaw_std: float = Field(0.005, ge=0, description="[rad]")
-    vio_velocity_std: float = Field(0.02, ge=0, description="[m/s]")
-    vio_yaw_rate_std: float = Field(0.01, ge=0, description="[rad/s]")
+    encoder_velocity_std: Annotated[_Std, Field(le=5.0)] = Field(0.01, description="[rad/s]")
+    torque_std: Annotated[_Std, Field(le=50.0)] = Field(0.05, description="[N m]")
+    # A camera-IMU odometry runs at most at a camera's 1 kHz.
+    vio_hz: Annotated[Real, Field(gt=0.0, le=1000.0)] = Field(30.0, description="[Hz]")
+    vio_latency: Annotated[_Std, Field(le=1.0)] = Field(
+        0.03, description="[s] capture-to-delivery delay"
+    )
+    vio_position_std: Annotated[_Std, Field(le=1.0)] = Field(0.01, description="[m]")
+    vio_yaw_std: Annotated[_Std, Field(le=0.5)] = Field(0.005, description="[rad]")
+    vio_velocity_std: Annotated[_Std, Field(le=5.0)] = Field(0.02, description="[m/s]")
+    vio_yaw_rate_std: Annotated[_Std, Field(le=5.0)] = Field(0.01, description="[rad/s]")
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,8 @@ from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, SimulationDiverged
 from ridempc.heap import frozen_heap
-from ridempc.scenarios.scenario import Disturbance, ParameterChange, Scenario
+from ridempc.scenarios.scenario import Disturbance, Scenario
+from ridempc.sim.changes import ScheduledChanges
 from ridempc.sim.clock import Rate
 from ridempc.sim.falls import FallDetector
 from ridempc.sim.motors import MotorDriver
@@ -152,9 +153,9 @@ class Simulation:
             controller is not None and type(controller).estimate is not Controller.estimate
         )
         self._pushes = [(self._body_of(d), d) for d in scenario.disturbances]
-        self._changes: dict[int, list[ParameterChange]] = {}  # by the physics step they are due
-        for change in scenario.changes:
-            self._changes.setdefault(round(change.t * hz), []).append(change)
+        self.changes = ScheduledChanges(
+            scene, scenario.changes, self.firmware, self.driver, f"scenario '{scenario.name}'"
+        )
 
     def _body_of(self, disturbance: Disturbance) -> int:
         if disturbance.body == "base":
@@ -179,14 +180,6 @@ class Simulation:
                 scale = mass if push.per_kg else 1.0
                 data.xfrc_applied[body, :3] += scale * np.asarray(push.force)
                 data.xfrc_applied[body, 3:] += scale * np.asarray(push.torque)
-
-    def _apply_changes(self, tick: int, model: mujoco.MjModel) -> None:
-        for change in self._changes.get(tick, ()):
-            if change.parameter == "floor_friction":
-                for geom in self.scene.ground_geoms:
-                    model.geom_friction[geom, 0] = change.value
-            elif change.parameter == "base_payload":
-                model.body_mass[self.scene.base_body] += change.value
 
     def _log_row(self, recorder: Recorder, t: float, data: mujoco.MjData) -> None:
         scene = self.scene
@@ -290,12 +283,12 @@ class Simulation:
         n_ticks = round(self.scenario.duration * hz)
         recorder = Recorder()
         times: list[float] = []
-        friction, masses = model.geom_friction.copy(), model.body_mass.copy()
         result = RunResult(status="ok", sim_time=0.0, wall_time=0.0)
         tick = 0
         with frozen_heap():  # the models and the library stay out of the collector's walks
             start = time.perf_counter()
             try:
+                self.changes.apply(0, data)  # before the first step: a heavier rider starts so
                 for tick in range(n_ticks + 1):
                     t = tick / hz
                     if self.log_rate.due(tick):
@@ -309,7 +302,8 @@ class Simulation:
                         self.on_frame(model, data)
                     if tick == n_ticks:
                         break
-                    self._apply_changes(tick, model)
+                    if tick:
+                        self.changes.apply(tick, data)
                     self._apply_disturbances(t, data)
                     if self.external is not None:
                         self.external(t, model, data)
@@ -324,8 +318,7 @@ class Simulation:
             except SimulationDiverged as exc:
                 result.status, result.error = "failed", str(exc)
             finally:  # parameter changes last one run only
-                model.geom_friction[:] = friction
-                model.body_mass[:] = masses
+                self.changes.restore()
         result.sim_time = tick / hz
         result.wall_time = time.perf_counter() - start
         result.log = recorder.arrays()

@@ -13,6 +13,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from ridempc.io import atomic_savefig
 from ridempc.sim.video import tracking_camera
 
 __all__ = ["SnapshotStrip"]
@@ -60,6 +61,11 @@ class SnapshotStrip:
         self._renderer.update_scene(data, self._camera)
         return self._renderer.render().copy()
 
+    def discard(self) -> None:
+        """Release the renderer and write nothing (the run did not finish)."""
+        self.frames.clear()
+        self._renderer.close()
+
     def close(self, data: mujoco.MjData | None = None) -> None:
         """Take the missing last frame from ``data`` (a run that ended early shows its end)
         and write the PNG; nothing is written without frames."""
@@ -79,7 +85,7 @@ class SnapshotStrip:
             ax.set_title(f"t = {time:.1f} s", fontsize=10)
             ax.axis("off")
         fig.tight_layout()
-        tmp = self.path.with_name(f".{self.path.name}.tmp.png")
-        fig.savefig(tmp, dpi=100)
-        plt.close(fig)
-        tmp.replace(self.path)
+        try:
+            atomic_savefig(fig, self.path, dpi=100)
+        finally:
+            plt.close(fig)

@@ -7,7 +7,25 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-__all__ = ["VideoRecorder", "tracking_camera"]
+__all__ = ["VideoRecorder", "require_video_writer", "tracking_camera"]
+
+
+def require_video_writer() -> None:
+    """Refuse ``--video`` up front when the ``video`` extra (the ffmpeg binary) is missing.
+
+    Raises:
+        ConfigError: imageio-ffmpeg is not installed; the message names the extra.
+    """
+    import importlib.util
+
+    from ridempc.errors import ConfigError
+
+    if importlib.util.find_spec("imageio_ffmpeg") is None:
+        raise ConfigError(
+            "--video needs the 'video' extra (the ffmpeg binary, about 170 MB), which is not "
+            "installed: pip install \"ridempc[video]\" "
+            "(from a checkout: pip install -e \".[video]\")"
+        )
 
 
 def tracking_camera(track_body: int, distance: float) -> mujoco.MjvCamera:
@@ -56,9 +74,11 @@ class VideoRecorder:
         self.frames += 1
 
     def close(self, keep: bool = True) -> None:
-        self._writer.close()
-        self._renderer.close()
-        if keep and self.frames:
-            self._tmp.replace(self.path)
-        else:
+        """Finish the file and rename it into place (``keep`` and frames), else remove it."""
+        try:
+            self._writer.close()
+            self._renderer.close()
+            if keep and self.frames:
+                self._tmp.replace(self.path)
+        finally:
             self._tmp.unlink(missing_ok=True)

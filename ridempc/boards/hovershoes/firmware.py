@@ -106,6 +106,12 @@ class HovershoesFirmware(Firmware):
         super().__init__(params, io)
         self.shoes = tuple(ShoeController(params, io, side) for side in SIDES)
 
+    def reconfigure(self, params: BoardParameters) -> None:
+        assert isinstance(params, HovershoesParameters)
+        super().reconfigure(params)
+        for shoe in self.shoes:
+            shoe.params = params
+
     def update(self) -> None:
         for shoe in self.shoes:
             shoe.update()

@@ -11,14 +11,25 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator
+from pydantic import ValidationInfo, field_validator
 
-from ridempc.boards.parameters import BoardParameters, NonNegative, Positive
+from ridempc.boards.parameters import (
+    BoardParameters,
+    Friction,
+    GroundSpeed,
+    Length,
+    Mass,
+    MotorSpeed,
+    NonNegative,
+    Positive,
+    Torque,
+)
+from ridempc.units import CheckedModel
 
 __all__ = ["HovershoesParameters", "HovershoesReducedParameters"]
 
 
-class HovershoesReducedParameters(BaseModel):
+class HovershoesReducedParameters(CheckedModel):
     """Identified parameters of the reduced model, paper eq. (4)-(8) (see ``reduced.py``).
 
     Attributes:
@@ -30,8 +41,6 @@ class HovershoesReducedParameters(BaseModel):
         c4: Forward force per radian of pitch [N / rad].
         m: Loaded mass (shoe and its load) the figures were identified with [kg].
     """
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
 
     J_theta: Positive
     c1: Positive
@@ -68,19 +77,19 @@ class HovershoesParameters(BoardParameters):
     """
 
     kind: Literal["hovershoes"]
-    shoe_mass: Positive
-    wheel_mass: Positive
-    wheel_radius: Positive
-    wheel_width: Positive
-    platform_length: Positive
-    platform_width: Positive
-    platform_thickness: Positive
-    platform_height: Positive
-    shoe_spacing: Positive
-    platform_friction: Positive
-    motor_torque_limit: Positive
-    motor_speed_limit: Positive
-    speed_limit: Positive
+    shoe_mass: Mass
+    wheel_mass: Mass
+    wheel_radius: Length
+    wheel_width: Length
+    platform_length: Length
+    platform_width: Length
+    platform_thickness: Length
+    platform_height: Length
+    shoe_spacing: Length
+    platform_friction: Friction
+    motor_torque_limit: Torque
+    motor_speed_limit: MotorSpeed
+    speed_limit: GroundSpeed
     pitch_kp: Positive
     pitch_kd: NonNegative
     tilt_back_gain: NonNegative

@@ -53,6 +53,12 @@ class SegwayFirmware(Firmware):
         self.segway = params
         self._last: dict[str, float] = {}
 
+    def reconfigure(self, params: BoardParameters) -> None:
+        if not isinstance(params, SegwayParameters):
+            raise ConfigError(f"board '{params.name}': not a Segway's parameters")
+        super().reconfigure(params)
+        self.segway = params
+
     def update(self) -> None:
         p, g, io = self.segway, self.segway.gains, self.io
         pitch = platform_pitch(io.sensor("platform_quat"))

@@ -9,16 +9,32 @@ a :class:`~ridempc.errors.ConfigError` naming the field.
 
 from __future__ import annotations
 
-from typing import Literal, Self
+from typing import Annotated, Literal, Self
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
-from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive
+from ridempc.boards.parameters import (
+    Angle,
+    BoardParameters,
+    Clearance,
+    GroundSpeed,
+    Length,
+    Mass,
+    NonNegative,
+    Positive,
+    Real,
+    Torque,
+)
+from ridempc.units import CheckedModel
 
 __all__ = ["SegwayGains", "SegwayParameters", "SegwayReducedParameters"]
 
+# A signed coefficient of the identified model (SI units): the committed ones are below
+# 5e3; beyond 1e5 the fit has failed, whatever the board.
+Coefficient = Annotated[Real, Field(ge=-1e5, le=1e5)]
 
-class SegwayGains(BaseModel):
+
+class SegwayGains(CheckedModel):
     """The firmware's gains and limits (table ``[gains]``).
 
     Balance, total over both wheels (eq. in :mod:`ridempc.boards.segway.firmware`):
@@ -36,8 +52,6 @@ class SegwayGains(BaseModel):
         yaw_rate_kp: Differential wheel torque per yaw-rate error [N m s / rad].
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
     pitch_kp: Positive
     pitch_kd: Positive
     speed_kv: NonNegative
@@ -47,7 +61,7 @@ class SegwayGains(BaseModel):
     yaw_rate_kp: Positive
 
 
-class SegwayReducedParameters(BaseModel):
+class SegwayReducedParameters(CheckedModel):
     """Identified reduced model (table ``[reduced]``; see :mod:`ridempc.boards.segway.reduced`).
 
     Attributes:
@@ -64,16 +78,14 @@ class SegwayReducedParameters(BaseModel):
         tau_turn: Time constant of the yaw rate's lag [s].
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
     pitch_inertia: Positive
     c1: Positive
     c2: Positive
-    c3: float
+    c3: Coefficient
     c4: Positive
-    c5: float
-    c6: float = 0.0
-    c7: float = 0.0
+    c5: Coefficient
+    c6: Coefficient = 0.0
+    c7: Coefficient = 0.0
     mass: Positive
     k_turn: Positive
     tau_turn: Positive
@@ -111,27 +123,27 @@ class SegwayParameters(BoardParameters):
     """
 
     kind: Literal["segway"]
-    wheel_radius: Positive
-    wheel_width: Positive
-    wheel_mass: Positive
-    track_width: Positive
-    chassis_mass: Positive
-    platform_length: Positive
-    platform_width: Positive
-    platform_thickness: Positive
-    platform_height: Positive
-    knee_bar_mass: Positive
-    knee_bar_height: Positive
-    knee_bar_radius: Positive
-    knee_bar_contact_from: NonNegative
-    knee_pad_width: Positive
-    knee_pad_depth: Positive
-    knee_pad_height: Positive
+    wheel_radius: Length
+    wheel_width: Length
+    wheel_mass: Mass
+    track_width: Length
+    chassis_mass: Mass
+    platform_length: Length
+    platform_width: Length
+    platform_thickness: Length
+    platform_height: Length
+    knee_bar_mass: Mass
+    knee_bar_height: Length
+    knee_bar_radius: Length
+    knee_bar_contact_from: Clearance
+    knee_pad_width: Length
+    knee_pad_depth: Length
+    knee_pad_height: Length
     knee_bar_stiffness: Positive
     knee_bar_damping: NonNegative
     knee_bar_range: Angle
-    motor_torque_limit: Positive
-    top_speed: Positive
+    motor_torque_limit: Torque
+    top_speed: GroundSpeed
     gains: SegwayGains
     reduced: SegwayReducedParameters | None = Field(default=None)
 

@@ -15,14 +15,23 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
-from ridempc.boards.parameters import Angle, BoardParameters, NonNegative, Positive
+from ridempc.boards.parameters import (
+    Angle,
+    BoardParameters,
+    Length,
+    Mass,
+    NonNegative,
+    Positive,
+    Real,
+)
+from ridempc.units import CheckedModel
 
 __all__ = ["SkateboardParameters", "SkateboardReducedParameters"]
 
 
-class SkateboardReducedParameters(BaseModel):
+class SkateboardReducedParameters(CheckedModel):
     """Identified reduced model: deck roll eq. (6)-(7) and the kinematic gain of eq. (14).
 
     Attributes:
@@ -32,8 +41,6 @@ class SkateboardReducedParameters(BaseModel):
         steer_gain: Yaw rate per forward speed and sine of roll,
             :math:`1 / K_{board} = (\\cot\\gamma_f + \\cot\\gamma_r) / L` [1 / m].
     """
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
 
     roll_inertia: Positive
     roll_stiffness: Positive
@@ -69,22 +76,22 @@ class SkateboardParameters(BoardParameters):
     """
 
     kind: Literal["skateboard"]
-    deck_length: Positive
-    deck_width: Positive
-    deck_thickness: Positive
-    deck_mass: Positive
-    height: Positive
-    wheelbase: Positive
-    truck_width: Positive
-    truck_mass: Positive
-    wheel_radius: Positive
-    wheel_width: Positive
-    wheel_mass: Positive
+    deck_length: Length
+    deck_width: Length
+    deck_thickness: Length
+    deck_mass: Mass
+    height: Length
+    wheelbase: Length
+    truck_width: Length
+    truck_mass: Mass
+    wheel_radius: Length
+    wheel_width: Length
+    wheel_mass: Mass
     rake_front: Angle
     rake_rear: Angle
     bushing_stiffness: Positive
     bushing_damping: NonNegative
-    roll_limit: float = Field(gt=0.0, lt=0.5, description="[rad]")
+    roll_limit: Real = Field(gt=0.0, lt=0.5, description="[rad]")
     wheel_friction_torque: NonNegative
     wheel_damping: NonNegative
     reduced: SkateboardReducedParameters | None = None
