@@ -1,0 +1,62 @@
+"""The delayed joint PD's phase margin (:mod:`ridempc.robots.delay_margin`), and the robots'
+hold gains checked against it at their stand keyframe."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from ridempc.robots import load_robot
+from ridempc.robots.delay_margin import effective_delay, gain_bound, joint_inertias, phase_margin
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.motors import delay_steps
+
+STEP = 1.0 / DEFAULT_PHYSICS_HZ
+
+
+def _loop(inertia: float, kp: float, kd: float, delay: float, w: np.ndarray) -> np.ndarray:
+    s = 1j * w
+    return (kp + kd * s) * np.exp(-s * delay) / (inertia * s**2)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_margin_is_the_loops_phase_at_its_crossover(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    inertia, kp, kd, delay = rng.uniform([0.01, 10.0, 0.5, 0.001], [1.0, 3000.0, 50.0, 0.005])
+    w = np.geomspace(1.0, 1e5, 200_001)
+    loop = _loop(inertia, kp, kd, delay, w)
+    i = np.argmin(np.abs(np.abs(loop) - 1.0))
+    # the phase of L plus pi, wrapped to (-pi, pi]
+    expected = np.angle(loop[i] * -1.0)
+    assert phase_margin(inertia, kp, kd, delay) == pytest.approx(expected, abs=1e-3)
+
+
+@pytest.mark.parametrize("margin", [math.pi / 6, math.pi / 4, math.pi / 3])
+def test_the_bound_has_the_margin_asked_for(margin: float) -> None:
+    inertia, delay = 0.1, effective_delay(5, STEP)
+    kp, kd = gain_bound(inertia, delay, margin)
+    assert phase_margin(inertia, kp, kd, delay) == pytest.approx(margin, abs=1e-9)
+    assert kd * math.sqrt(1.0 + 0.25) * delay == pytest.approx(inertia * (math.atan(2.0) - margin))
+
+
+def test_the_segway_riders_legs_keep_the_margin() -> None:
+    """The `pd` Segway rider's hip pitch and knee, in its crouch, keep 40 deg of margin
+    through Cassie's motor delay (at 100/50 in the crouch they chattered at the curve's limit)."""
+    from ridempc.baselines.cassie_segway_gains import load_segway_gains
+
+    cassie = load_robot("cassie")
+    joints = load_segway_gains().standing.joints
+    model = cassie.mj_model
+    data = mujoco.MjData(model)
+    key = cassie.params.ride_keyframes["segway"]
+    mujoco.mj_resetDataKeyframe(model, data, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, key))
+    mujoco.mj_forward(model, data)
+    for name, gains in (("left_hip_pitch", joints.hip_pitch), ("left_knee", joints.knee)):
+        motor = next(m for m in cassie.motors if m.name == name)
+        dof = model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, motor.joint)]
+        inertia = joint_inertias(model, data, np.array([dof]))[0]
+        delay = effective_delay(delay_steps(motor.torque_delay, STEP), STEP)
+        assert phase_margin(inertia, gains.kp, gains.kd, delay) > math.radians(40.0), name
