@@ -683,5 +683,7 @@ def test_the_wbc_alone_stands_on_the_hovershoes_knowing_they_roll() -> None:
             continue
         speed = np.abs(result.log["board_velocity"][:, :, 0]).max()
         ends[rolling] = (result.status, speed)
-    assert ends[True][0] == "ok" and ends[True][1] < 0.6, ends  # [m/s] (0.46 measured)
+    # the shoes held under the rider against run off: 1 m/s parts the two (knowing they roll,
+    # 0.46 m/s at the most without a motor delay, 0.64 with Cassie's 3 ms one)
+    assert ends[True][0] == "ok" and ends[True][1] < 1.0, ends  # [m/s]
     assert ends[False][0] != "ok" or ends[False][1] > 1.0, ends
