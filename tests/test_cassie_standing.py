@@ -185,7 +185,7 @@ def test_default_gains_load(cassie) -> None:
         ("kp = 3.0               # [-]", "kp = -3.0", "com_x.kp"),
         ("filter_hz = 10.0", "filter_hz = 10.0\nkq = 1.0", "roll.kq"),
         ("max_length = 0.95", "max_length = 0.4", "legs"),
-        ("knee = { kp = 3000.0, kd = 50.0 }", 'knee = { kp = "stiff", kd = 50.0 }', "knee.kp"),
+        ("knee = { kp = 3000.0, kd = 25.0 }", 'knee = { kp = "stiff", kd = 25.0 }', "knee.kp"),
     ],
 )
 def test_bad_gain_file_is_refused_naming_the_field(cassie, tmp_path, old, new, field) -> None:

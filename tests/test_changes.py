@@ -27,7 +27,6 @@ from ridempc.scenarios.scenario import CommandEvent, ParameterChange, Scenario
 from ridempc.sim.changes import ScheduledChanges
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.knobs import KNOBS, SCALE_MAX
-from ridempc.sim.motors import MotorCommand
 from ridempc.sim.scene import BOARD_PREFIX, Scene, build_scene
 from ridempc.sim.simulation import Simulation
 
@@ -92,14 +91,10 @@ def _gain(*path: str) -> Callable[[Simulation], float]:
 
 
 def _peak_torque(sim: Simulation) -> float:
-    """The first motor's torque under an unreachable torque command [N m]."""
+    """The first motor's torque available at standstill [N m] (its curve's peak)."""
     driver = sim.driver
     assert driver is not None
-    n = len(sim.scene.actuator_ids)
-    zero = np.zeros(n)
-    driver.command = MotorCommand(np.full(n, 1.0e6), zero, zero, zero, zero)
-    sim.scene.data.qvel[:] = 0.0
-    return float(driver.torque(sim.scene.data)[0])
+    return float(driver.curve.limit(np.zeros(len(sim.scene.actuator_ids)))[0])
 
 
 # (board, the change without value or scale, what it reads, a value, a scale)

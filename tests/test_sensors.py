@@ -36,8 +36,11 @@ def test_packet_contents_match_the_robot(robot) -> None:
     assert last.joint_position.shape == (len(robot.encoder_joints),)
     assert last.motor_torque.shape == (len(robot.motors),)
     assert np.isclose(np.linalg.norm(last.imu.quaternion), 1.0)
-    # standing still: the accelerometer reads gravity's reaction, about +9.81 up in the body
-    assert 9.0 < np.linalg.norm(last.imu.linear_acceleration) < 10.6
+    # standing: the accelerometer reads gravity's reaction, about +9.81 up in the body, on
+    # average over the ride (its mean is g plus the change of the body's velocity over it);
+    # single samples swing by several m/s^2 while a leaf-spring robot settles (Cassie)
+    mean = np.mean([p.imu.linear_acceleration for p in packets], axis=0)
+    assert 9.3 < np.linalg.norm(mean) < 10.3
     assert last.vio is not None
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -16,6 +17,7 @@ from ridempc.trajopt.problem import collocation_defect, solve_trajectory
 from ridempc.trajopt.ride_pair import ride_models
 from ridempc.trajopt.ride_problem import ride_layout
 from ridempc.trajopt.rigid_body import GRAVITY, feet_world
+from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skate_pair import skate_models, skate_options
 from ridempc.trajopt.skate_problem import inward_distances, skate_schedule, triangle_turn
@@ -178,3 +180,25 @@ def test_the_pushing_foot_lifts_unloaded() -> None:
             assert force <= options.liftoff_force * weight_per_foot + 1e-6, (
                 f"{entry.record.name} at {entry.times[k]:.2f} s: {force:.1f} N"
             )
+
+
+def test_the_stance_legs_stay_under_the_motor_curves() -> None:
+    """Every skateboard entry's stance-leg statics torques stay within ``torque_fraction`` of
+    the motors' torque-speed curves at the entry's planned joint rates (the NLP's rows,
+    measured here with NumPy): the curves hold for the committed entries."""
+    robot, _ = skate_models()
+    nf, nr = robot.n_feet, 12 + robot.n_joints
+    q = ca.SX.sym("q", robot.n_joints)
+    jacobians = ca.Function("jacobians", [q], [robot.foot_jacobian(q, i) for i in range(nf)])
+    for entry, options, _ in _skate_entries():
+        for k, u in enumerate(entry.inputs):
+            x = entry.states[k]
+            rotation = euler_zyx_matrix(x[3], x[4], x[5], np)
+            jac = jacobians(x[12:nr])
+            limit = options.torque_fraction * robot.curve.limit(u[3 * nf :])
+            for i in range(nf):
+                leg = list(robot.legs[i])
+                torque = np.asarray(jac[i])[:, leg].T @ (rotation.T @ u[3 * i : 3 * i + 3])
+                assert np.all(np.abs(torque) <= limit[leg] + 1e-6), (
+                    f"{entry.record.name} at {entry.times[k]:.2f} s, foot {robot.feet[i]}"
+                )

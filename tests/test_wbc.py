@@ -32,7 +32,7 @@ from ridempc.errors import ConfigError, RidempcError
 from ridempc.estimation import BoardEstimate, EstimatedState, StateEstimator
 from ridempc.friction import pyramid_slope
 from ridempc.mpc.rider import platform_feet, rolling_platforms
-from ridempc.robots import load_robot
+from ridempc.robots import TorqueSpeedCurve, load_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command, Disturbance, Scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -149,7 +149,7 @@ def test_solution_obeys_dynamics_contacts_friction_and_limits(robot, springs: Sp
     wbc = WholeBodyController(robot, settings)
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     layout = wbc.model.layout
-    limits = np.array([m.torque_limit for m in robot.motors])
+    curve = TorqueSpeedCurve.of(robot.motors)
     rigid = wbc.model.spring_v if springs == "rigid" else np.zeros(0, dtype=np.int64)
     held = np.setdiff1d(np.arange(layout.nv), rigid)  # dynamics rows that must hold
     rng = np.random.default_rng(20260601)
@@ -182,7 +182,8 @@ def test_solution_obeys_dynamics_contacts_friction_and_limits(robot, springs: Sp
         assert np.all(np.abs(forces[standing, :2]) <= mu * forces[standing, 2:3] + 1e-6)
         assert np.max(np.abs(forces[~standing]), initial=0.0) < 1e-6
         assert np.allclose(out.forces.sum(axis=0), forces.sum(axis=0))
-        assert np.all(np.abs(out.torque) <= limits + 1e-6)
+        # within the torque-speed curve at the motors' speeds, and so within the peaks
+        assert np.all(np.abs(out.torque) <= curve.limit(v[wbc.motor_v]) + 1e-6)
         # the joint targets integrate the acceleration over one tick
         dt = settings.dt
         qdd = out.acceleration[wbc.motor_v]
@@ -682,5 +683,7 @@ def test_the_wbc_alone_stands_on_the_hovershoes_knowing_they_roll() -> None:
             continue
         speed = np.abs(result.log["board_velocity"][:, :, 0]).max()
         ends[rolling] = (result.status, speed)
-    assert ends[True][0] == "ok" and ends[True][1] < 0.6, ends  # [m/s] (0.46 measured)
+    # the shoes held under the rider against run off: 1 m/s parts the two (knowing they roll,
+    # 0.46 m/s at the most without a motor delay, 0.64 with Cassie's 3 ms one)
+    assert ends[True][0] == "ok" and ends[True][1] < 1.0, ends  # [m/s]
     assert ends[False][0] != "ok" or ends[False][1] > 1.0, ends

@@ -6,7 +6,7 @@ Each robot lives in ``robots/<name>/`` as two files:
   source of kinematics, inertias, joint ranges, gear ratios and motor torque limits).
 - ``robot.toml``: this module's :class:`RobotParameters`: which body is the base,
   where the IMU sits, which bodies are feet, the foot contact points, the fall
-  threshold, and the low-level PD gains and speed limits of each motor.
+  threshold, and each motor's low-level PD gains and torque-speed curve.
 
 A second robot of a class is a new folder with these two files, never new code.
 """
@@ -31,16 +31,34 @@ class _Frozen(CheckedModel):
 
 
 class MotorParameters(_Frozen):
-    """Low-level joint PD of one motor, as the motor driver runs it.
+    """Low-level joint PD and torque-speed curve of one motor, as the motor driver runs it.
 
     The driver applies, at the physics rate,
     :math:`\\tau = \\tau_{ff} + k_p (q^* - q) + k_d (\\dot q^* - \\dot q)`,
-    clipped to the actuator's torque limit from the MJCF description.
+    clipped to the torque-speed curve (:mod:`ridempc.robots.motor_curve`): the peak torque
+    (the actuator's torque limit in the MJCF description) up to
+    ``full_torque_fraction * speed_limit``, falling linearly to zero at ``speed_limit``, and
+    reaching the joint ``torque_delay`` later.
     """
 
     kp: NonNegativeFloat = Field(description="Default joint stiffness [N m / rad].")
     kd: NonNegativeFloat = Field(description="Default joint damping [N m s / rad].")
-    speed_limit: PositiveFloat = Field(description="Joint speed limit [rad / s].")
+    speed_limit: PositiveFloat = Field(
+        description="No-load joint speed [rad / s]: the curve gives no torque at or beyond it."
+    )
+    full_torque_fraction: float = Field(
+        gt=0.0,
+        lt=1.0,
+        description=(
+            "Share of the no-load speed up to which the motor gives its peak torque (the "
+            "curve's corner) [-]."
+        ),
+    )
+    torque_delay: float = Field(
+        ge=0.0,
+        le=0.1,
+        description="Time a torque command takes to reach the joint [s] (at most 0.1 s).",
+    )
 
 
 class RobotParameters(_Frozen):

@@ -1,7 +1,7 @@
 """A robot: its MJCF description, its parameter file, and what follows from them.
 
 The description is compiled once on its own (no floor, no board) to read what both
-the simulation and the controllers need: motor joints, gear ratios, torque limits and
+the simulation and the controllers need: motor joints, gear ratios, peak torques and
 the standing keyframe. Everything here is read from the two files in
 ``robots/<name>/``; nothing is specific to one robot.
 """
@@ -32,10 +32,13 @@ class Motor:
         name: Actuator name, equal to its joint's name.
         joint: Joint name.
         gear: Gear ratio (joint torque = gear * motor torque).
-        torque_limit: Joint-side torque limit [N m] (= gear * motor-side limit).
-        speed_limit: Joint speed limit [rad / s].
+        torque_limit: Joint-side peak torque [N m] (= gear * motor-side limit).
+        speed_limit: Joint no-load speed [rad / s]: no torque at or beyond it.
         kp: Default low-level stiffness [N m / rad].
         kd: Default low-level damping [N m s / rad].
+        full_torque_fraction: Share of ``speed_limit`` up to which the peak torque is
+            available [-] (:class:`~ridempc.robots.motor_curve.TorqueSpeedCurve`).
+        torque_delay: Time a torque command takes to reach the joint [s].
     """
 
     name: str
@@ -45,6 +48,8 @@ class Motor:
     speed_limit: float
     kp: float
     kd: float
+    full_torque_fraction: float
+    torque_delay: float
 
 
 @dataclass(frozen=True)
@@ -96,7 +101,19 @@ class Robot:
             gear = float(model.actuator_gear[i, 0])
             ctrl_max = float(np.max(np.abs(model.actuator_ctrlrange[i])))
             p = self.params.motors[name]
-            motors.append(Motor(name, joint, gear, gear * ctrl_max, p.speed_limit, p.kp, p.kd))
+            motors.append(
+                Motor(
+                    name,
+                    joint,
+                    gear,
+                    gear * ctrl_max,
+                    p.speed_limit,
+                    p.kp,
+                    p.kd,
+                    p.full_torque_fraction,
+                    p.torque_delay,
+                )
+            )
             names.add(name)
         extra = set(self.params.motors) - names
         if extra:

@@ -97,6 +97,13 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> d
             m.name: round(float(p), 3) for m, p in zip(robot.motors, peak, strict=True)
         }
         metrics["peak_torque_ratio"] = float(np.max(peak / limits))
+    if robot is not None and "motor_demand" in log:
+        # where the torque-speed curve cut what the PD and feedforward asked for
+        cut = np.abs(log["motor_demand"]) > log["motor_available"] + 1e-9
+        metrics["curve_limited_share"] = {
+            m.name: round(float(s), 4) for m, s in zip(robot.motors, cut.mean(axis=0), strict=True)
+        }
+        metrics["curve_limited_share_max"] = float(cut.mean(axis=0).max())
     if "board_quaternion" in log and _tracks(scenario, "roll"):
         roll = board_roll(log["board_quaternion"][:, 0])
         metrics["roll_rmse"] = _rmse(roll[window] - log["command_roll"][window])

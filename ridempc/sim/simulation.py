@@ -6,7 +6,8 @@ Every physics step (``1 / physics_hz`` s), in this order:
 2. the VIO captures a sample if due (delivered later, after its latency);
 3. the rider controller runs if due, on a fresh sensor packet and the scenario's command;
 4. the board's firmware runs if due, on the board's own sensors;
-5. the motor drivers apply their PD law to the latest motor command;
+5. the motor drivers apply their PD law to the latest motor command, within the torque-speed
+   curve, through the torque delay line (:mod:`ridempc.sim.motors`);
 6. MuJoCo steps.
 
 Controllers run every ``physics_hz / rate_hz`` steps exactly (see :mod:`ridempc.sim.clock`).
@@ -206,6 +207,8 @@ class Simulation:
                 qpos=data.qpos[scene.robot_qpos],
                 qvel=data.qvel[scene.robot_qvel],
                 motor_torque=self.driver.torque(data),
+                motor_demand=self.driver.demand,
+                motor_available=self.driver.available,
             )
         if scene.board_roots:
             board_velocity = np.empty((len(scene.board_roots), 6))
@@ -274,6 +277,8 @@ class Simulation:
         scene = self.scene
         model, data = scene.model, scene.data
         scene.reset()
+        if self.driver is not None:
+            self.driver.reset()
         hz = scene.physics_hz
         n_ticks = round(self.scenario.duration * hz)
         recorder = Recorder()

@@ -40,6 +40,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.trajopt.kinematics import frame_kinematics
@@ -94,8 +95,9 @@ class RigidBodyRobot:
         q_reference: Joint angles of the reference stance [rad].
         q_lower: Lower joint limits [rad].
         q_upper: Upper joint limits [rad].
-        torque_limit: Joint torque limits [N m].
-        speed_limit: Joint speed limits [rad/s].
+        torque_limit: Joint torque limits [N m] (the curves' peaks).
+        speed_limit: Joint speed limits [rad/s] (the curves' no-load speeds).
+        curve: The motors' torque-speed curves, in the order of :math:`q_j`.
         feet: Contact sites, the order of the feet.
         foot_radius: Distance from each contact site to its contact point [m] (a sphere
             foot's radius; 0 for a site on the sole).
@@ -115,6 +117,7 @@ class RigidBodyRobot:
     q_upper: Array
     torque_limit: Array
     speed_limit: Array
+    curve: TorqueSpeedCurve
     feet: tuple[str, ...]
     foot_radius: Array
     legs: tuple[tuple[int, ...], ...]
@@ -206,6 +209,7 @@ def build_rigid_body_robot(robot: Robot, keyframe: str) -> RigidBodyRobot:
         q_upper=np.array([model.upperPositionLimit[i] for i in q_index]),
         torque_limit=np.array([model.effortLimit[i] for i in v_index]),
         speed_limit=np.array([model.velocityLimit[i] for i in v_index]),
+        curve=TorqueSpeedCurve.of(robot.motors),
         feet=feet,
         foot_radius=np.array([_site_to_contact(mj, s) for s in feet]),
         legs=tuple(legs),

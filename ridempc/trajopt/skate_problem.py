@@ -18,7 +18,9 @@ contact schedule's grid (:mod:`.schedule`), Hermite-Simpson within each interval
   cone's inner pyramid, :mod:`ridempc.friction`; :math:`f_n \\ge 0`) on the surface's
   normal, no force on a swinging foot;
 - joint torques of the stance legs, :math:`\\tau = -J_i(q)^\\top R_R^\\top f_i` (the massless
-  leg's statics), within ``torque_fraction`` of the motor limits (12 N m on CyberDog2);
+  leg's statics), within ``torque_fraction`` of the motor limits (12 N m on CyberDog2),
+  the flat part of the torque-speed curves (:mod:`ridempc.robots.motor_curve`): the planned
+  joint rates stay below its corner, which ``tests/test_trajopt_library.py`` checks;
   joint angles and speeds within the MJCF's and ``robot.toml``'s limits; board roll within
   its bottom-out angle; board speed bounded;
 - swinging feet: clear of the deck (above its top while over it, beside it otherwise) and

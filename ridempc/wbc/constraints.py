@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.friction import pyramid_matrix
+from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
@@ -35,6 +36,7 @@ __all__ = [
     "PlatformTipConstraint",
     "RigidSpringConstraint",
     "TorqueLimitConstraint",
+    "TorqueSpeedConstraint",
 ]
 
 Array = NDArray[np.float64]
@@ -397,3 +399,29 @@ class TorqueLimitConstraint(Constraint):
         block.matrix[self._entries] = 1.0
         block.lower[:] = -self._limits
         block.upper[:] = self._limits
+
+
+class TorqueSpeedConstraint(TorqueLimitConstraint):
+    """Motor torque limits at the motors' speeds:
+    :math:`-\\tau_{lim}(\\dot q) \\le \\tau \\le \\tau_{lim}(\\dot q)` [N m], from the
+    torque-speed curve the motor drivers apply (:mod:`ridempc.robots.motor_curve`), so the QP
+    plans no torque the motors cannot give at their present speed.
+
+    Args:
+        layout: The decision vector's layout.
+        curve: The motors' torque-speed curves, actuator order.
+        motor_v: Each motor joint's index in the velocity vector, actuator order.
+    """
+
+    def __init__(self, layout: DecisionLayout, curve: TorqueSpeedCurve, motor_v: Index) -> None:
+        super().__init__(layout, curve.peak)
+        self._curve = curve
+        self._motor_v = np.asarray(motor_v, dtype=np.int64)
+
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        block.matrix[self._entries] = 1.0
+        limits = self._curve.limit(terms.v[self._motor_v])
+        block.lower[:] = -limits
+        block.upper[:] = limits

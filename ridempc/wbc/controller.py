@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.estimation.state import EstimatedState
+from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.robots.pinocchio_model import PinocchioRobot
 from ridempc.robots.robot import Robot
 from ridempc.sim.motors import MotorCommand
@@ -43,7 +44,7 @@ from ridempc.wbc.constraints import (
     FrictionPyramidConstraint,
     PlatformTipConstraint,
     RigidSpringConstraint,
-    TorqueLimitConstraint,
+    TorqueSpeedConstraint,
 )
 from ridempc.wbc.contacts import ContactSet, build_contact_set
 from ridempc.wbc.model import ModelTerms, WholeBodyModel
@@ -177,7 +178,7 @@ class WholeBodyController:
             FrictionPyramidConstraint(
                 layout, s.friction, s.min_normal_force, s.max_normal_force * weight, s.pyramid
             ),
-            TorqueLimitConstraint(layout, np.array([m.torque_limit for m in self.robot.motors])),
+            TorqueSpeedConstraint(layout, TorqueSpeedCurve.of(self.robot.motors), self.motor_v),
             PlatformTipConstraint(layout, self._tipping),
         ]
 
