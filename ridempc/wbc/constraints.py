@@ -259,7 +259,8 @@ class FrictionPyramidConstraint(Constraint):
               f_{min} \\le n^\\top f_s \\le f_{max}
 
     [N] for a site in contact (the pyramid implies :math:`n^\\top f_s \\ge 0`, so with
-    :math:`f_{min} = 0` the normal row only bounds from above), or in the ``diamond``
+    :math:`f_{min} = 0` the normal row only bounds from above; a site's ``least_force`` in the
+    :class:`~ridempc.wbc.contacts.ContactSet` raises its :math:`f_{min}`), or in the ``diamond``
     :math:`|t_1^\\top f_s| + |t_2^\\top f_s| \\le \\mu\\, n^\\top f_s`. A site in the air gets
     no force, :math:`f_s = 0`, as three equalities on the same rows (the first and third
     tangent rows and the normal: :math:`(t_1 - s n)^\\top f_s = (t_2 - s n)^\\top f_s =
@@ -316,6 +317,12 @@ class FrictionPyramidConstraint(Constraint):
         active = np.repeat(contacts.active, 5)
         block.lower[:] = np.where(active, self._contact_lower, self._swing_lower)
         block.upper[:] = np.where(active, self._contact_upper, self._swing_upper)
+        if contacts.least_force is not None:
+            normal = 5 * np.arange(self.layout.n_sites) + 4
+            bounded = contacts.active & (contacts.least_force > 0.0)
+            block.lower[normal] = np.where(
+                bounded, np.maximum(block.lower[normal], contacts.least_force), block.lower[normal]
+            )
 
 
 class PlatformTipConstraint(Constraint):

@@ -73,6 +73,8 @@ class ContactSet:
             sideways offset from the platform's axis over the deck's height
             :math:`y_s / h` [-], and (at each site) half the tread over the height
             :math:`w / 2h` [-] (:class:`~ridempc.wbc.constraints.PlatformTipConstraint`).
+        least_force: Each active site's least normal force [N] this tick, over the
+            settings' (:class:`~ridempc.wbc.in_flight.TorquesInFlight`); None: the settings'.
     """
 
     active: NDArray[np.bool_]
@@ -80,6 +82,7 @@ class ContactSet:
     acceleration: Array
     coupling: Array | None = None
     tipping: tuple[tuple[Index, Array, Array], ...] = ()
+    least_force: Array | None = None
 
     @property
     def normal(self) -> Array:

@@ -12,8 +12,9 @@ actuators", after the MIT Cheetah's [26]):
 3. :class:`~ridempc.wbc.qp.WholeBodyQP` builds the QP on
    :math:`z = (\\ddot q, f, \\tau, \\lambda)` from the tasks (base orientation, centre of mass
    or base position, contact forces, swing feet, posture, regularisation) and constraints
-   (dynamics, closed chains, contact accelerations, friction pyramids, torque limits) and
-   solves it with OSQP;
+   (dynamics, closed chains, contact accelerations, friction pyramids, torque limits; a
+   line foot's sites kept pressing against the torques still in flight through the motors'
+   delay, :mod:`ridempc.wbc.in_flight`) and solves it with OSQP;
 4. the motor torques :math:`\\tau` go out as feedforward, with joint targets integrated
    over one tick, :math:`q^* = q + v\\,\\Delta t + \\tfrac12 \\ddot q\\,\\Delta t^2`,
    :math:`\\dot q^* = v + \\ddot q\\,\\Delta t`, for the motor drivers' PD
@@ -47,6 +48,7 @@ from ridempc.wbc.constraints import (
     TorqueSpeedConstraint,
 )
 from ridempc.wbc.contacts import ContactSet, build_contact_set
+from ridempc.wbc.in_flight import TorquesInFlight
 from ridempc.wbc.model import ModelTerms, WholeBodyModel
 from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import QpProblem, QpSolution, WholeBodyQP
@@ -107,6 +109,8 @@ class WholeBodyController:
         qp: The QP and its OSQP workspace.
         last_problem: The last tick's QP, or None.
         last_solution: The last tick's solution, or None.
+        in_flight: The last ticks' torques, still on their way through the motors' delay,
+            and the least site forces that keep the line feet flat against them.
     """
 
     def __init__(
@@ -144,6 +148,7 @@ class WholeBodyController:
         site_foot = self.model.site_foot
         self._site_to_foot = np.zeros((len(self.foot_names), len(site_foot)))
         self._site_to_foot[site_foot, np.arange(len(site_foot))] = 1.0
+        self.in_flight = TorquesInFlight(self.model, robot, self.settings.dt)
         self.last_problem: QpProblem | None = None
         self.last_solution: QpSolution | None = None
 
@@ -251,10 +256,14 @@ class WholeBodyController:
             targets.board_acceleration,
             self.platforms,
         )
+        least = self.in_flight.least_forces(state.time, targets.forces[:, 2])
+        if least is not None:
+            contacts = replace(contacts, least_force=least)
         problem = self.qp.build(terms, targets, contacts)
         build_time = time.perf_counter()
         solution = self.qp.solve(problem)
         end = time.perf_counter()
+        self.in_flight.record(state.time, solution.x[self.model.layout.torque])
         self.last_problem, self.last_solution = problem, solution
         return self._output(terms, solution, start, model_time, build_time, end)
 
