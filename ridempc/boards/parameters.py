@@ -72,6 +72,13 @@ class BoardParameters(CheckedModel):
     ground_bodies: tuple[str, ...] = Field(min_length=1)
     dead_weight_robot: str
 
+    @classmethod
+    def firmware_gains(cls) -> dict[str, tuple[str, ...]]:
+        """The gains the kind's firmware reads, by name: where each sits in the parameters
+        (a path of field names), for a scenario's ``firmware_gain`` change. None here: a
+        board without electronics (the skateboard) has no gains."""
+        return {}
+
 
 def read_board_toml(path: Path) -> dict[str, Any]:
     return read_toml(path, "board parameter file")

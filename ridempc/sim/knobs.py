@@ -41,21 +41,10 @@ if TYPE_CHECKING:
     from ridempc.scenarios.scenario import ParameterChange
     from ridempc.sim.changes import ScheduledChanges
 
-__all__ = ["FIRMWARE_GAINS", "KNOBS", "PAYLOAD_OFFSET_MAX", "SCALE_MAX", "Action", "Knob"]
+__all__ = ["KNOBS", "PAYLOAD_OFFSET_MAX", "SCALE_MAX", "Action", "Knob"]
 
 Array = NDArray[np.float64]
 Action = Callable[[mujoco.MjData], None]
-
-# Where each board kind's firmware reads its gains in the board's parameters: the named
-# fields of a table (None: every field of it; the top level is the empty path).
-FIRMWARE_GAINS: Mapping[str, tuple[tuple[str, ...], tuple[str, ...] | None]] = MappingProxyType(
-    {
-        "hovershoes": ((), ("pitch_kp", "pitch_kd", "tilt_back_gain")),
-        "segway": (("gains",), None),
-        "skateboard": ((), ()),  # passive: no electronics
-    }
-)
-
 
 @dataclass(frozen=True)
 class Knob:
@@ -289,15 +278,14 @@ def _wheel(changes: ScheduledChanges, change: ParameterChange) -> tuple[str, ...
 def _gain(changes: ScheduledChanges, change: ParameterChange) -> tuple[str, ...]:
     params = changes.board_params
     assert params is not None and change.gain is not None
-    table, names = FIRMWARE_GAINS.get(params.kind, ((), ()))
-    gains = names if names is not None else tuple(type(_get(params, table)).model_fields)
+    gains = type(params).firmware_gains()
     if change.gain not in gains:
         raise changes.refuse(
             change,
             f"'{change.gain}' is not a firmware gain of board '{params.name}' "
             f"(valid: {', '.join(gains) or f'none, the {params.kind} has no firmware gains'})",
         )
-    return (*table, change.gain)
+    return gains[change.gain]
 
 
 def _board_rebuild(changes: ScheduledChanges, old: BoardParameters, new: BoardParameters) -> Action:

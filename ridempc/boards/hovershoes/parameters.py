@@ -95,6 +95,11 @@ class HovershoesParameters(BoardParameters):
     tilt_back_gain: NonNegative
     reduced: HovershoesReducedParameters | None = None
 
+    @classmethod
+    def firmware_gains(cls) -> dict[str, tuple[str, ...]]:
+        """The shoe controller's gains, at the top level."""
+        return {name: (name,) for name in ("pitch_kp", "pitch_kd", "tilt_back_gain")}
+
     @field_validator("wheel_mass")
     @classmethod
     def _wheel_lighter_than_shoe(cls, value: float, info: ValidationInfo) -> float:

@@ -147,6 +147,11 @@ class SegwayParameters(BoardParameters):
     gains: SegwayGains
     reduced: SegwayReducedParameters | None = Field(default=None)
 
+    @classmethod
+    def firmware_gains(cls) -> dict[str, tuple[str, ...]]:
+        """Every field of the ``[gains]`` table."""
+        return {name: ("gains", name) for name in SegwayGains.model_fields}
+
     @model_validator(mode="after")
     def _fits_together(self) -> Self:
         if self.platform_thickness >= self.platform_height:
