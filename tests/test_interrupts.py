@@ -107,8 +107,9 @@ def test_a_ride_stops_at_once(
 
 
 def test_a_library_build_stops_at_once_and_stores_only_whole_entries(tmp_path: Path) -> None:
-    """IPOPT (CasADi turns the interrupt into a failed solve) or CasADi building the NLP
-    (compiled code that holds the interrupt: the watcher ends the process)."""
+    """The entries are solved in a worker process even with one job (CasADi holds the
+    interpreter lock while it builds an NLP), so the parent, which only waits, stops at
+    once and ends the worker."""
     out = tmp_path / "library"
     targets = (0.3, 0.5, 0.7)
     process = _start(

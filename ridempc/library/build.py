@@ -2,7 +2,9 @@
 
 Every target is checked against the pair's feasibility bound before anything is solved (an
 unreachable target is refused, nothing is written). Entries are then solved in worker
-processes (``jobs`` of them; in this process when ``jobs`` is 1), in order of kind and
+processes (``jobs`` of them, one process even when ``jobs`` is 1: CasADi holds Python's
+interpreter lock while it builds a problem, so only a parent that merely waits can stop
+within a second of Ctrl-C), in order of kind and
 target, each warm-started from the nearest entry of its kind already solved in this build
 (the lowest target of each kind starts cold, so a rebuild of it is reproducible). A solved
 entry is re-simulated (:mod:`ridempc.trajopt.validation`), written atomically and added to
@@ -16,7 +18,7 @@ from __future__ import annotations
 import dataclasses
 import sys
 from collections.abc import Sequence
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -146,18 +148,6 @@ def solve_entry(
     return result
 
 
-class _Inline(Executor):
-    """Runs submitted calls at once, in this process (``jobs == 1``)."""
-
-    def submit(self, fn: Any, /, *args: Any, **kwargs: Any) -> Future[Any]:
-        future: Future[Any] = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller through the future
-            future.set_exception(exc)
-        return future
-
-
 def _progress(total: int, enabled: bool) -> Any:
     try:
         from tqdm import tqdm
@@ -215,11 +205,7 @@ def build_library(
     pending = list(specs)
     running: dict[Future[dict[str, Any]], EntrySpec] = {}
     bar = _progress(len(specs), progress)
-    executor: Executor = (
-        _Inline()
-        if jobs == 1
-        else ProcessPoolExecutor(max_workers=jobs, initializer=worker_started)
-    )
+    executor = ProcessPoolExecutor(max_workers=jobs, initializer=worker_started)
 
     def neighbour_of(spec: EntrySpec) -> Neighbour | None:
         same = [n for n in solved.values() if n.metadata.get("kind") == spec.kind]
