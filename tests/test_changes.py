@@ -605,6 +605,7 @@ def test_successive_torque_limits_are_each_a_scale_of_the_description() -> None:
         "skateboard",
         {"parameter": "motor_torque_limit", "scale": 0.5},
         {"parameter": "motor_torque_limit", "t": 0.1, "scale": 0.8},
+        duration=0.1,
     )
     peak = _peak_torque(sim)
     tick = round(0.1 * sim.scene.physics_hz)

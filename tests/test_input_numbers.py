@@ -230,6 +230,8 @@ def test_the_full_scenario_rides_through_the_loader(tmp_path: Path) -> None:
         ({"waves": [{"field": "roll", "amplitude": 0.1, "period": 1.0, "start": 2.0,
                      "stop": 1.0}]}, "stop (1.0 s) must come after start"),
         ({"push_off": {"target": 0.5, "judged_at": 5.5}}, "push_off.judged_at = 5.5 s"),
+        ({"changes": [{"t": 8.0, "parameter": "floor_friction", "value": 0.5}]},
+         "changes.0.t = 8.0 s"),
     ],
 )  # fmt: skip
 def test_an_event_after_the_end_of_the_ride_is_refused(change, words) -> None:

@@ -291,6 +291,7 @@ class Scenario(_Frozen):
         times += [(f"commands.{i}.t", c.t) for i, c in enumerate(self.commands)]
         times += [(f"waves.{i}.start", w.start) for i, w in enumerate(self.waves)]
         times += [(f"disturbances.{i}.t", d.t) for i, d in enumerate(self.disturbances)]
+        times += [(f"changes.{i}.t", c.t) for i, c in enumerate(self.changes)]
         if self.push_off is not None:
             times.append(("push_off.judged_at", self.push_off.judged_at))
         for where, t in times:
