@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from ridempc.boards import board_names
+from ridempc.cli import main
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.sweep.distribution import (
     DISTRIBUTIONS_DIR,
@@ -170,3 +171,11 @@ def test_several_pushes_are_numbered(tmp_path: Path) -> None:
     laws = load_distribution(_file(tmp_path, text), "segway").quantities()
     assert {"push.0.magnitude", "push.1.t"} <= set(laws)
     assert math.isclose(laws["push.1.duration"].bounds()[0], 0.2)
+
+
+def test_ridempc_list_names_the_distributions_and_their_boards(capsys) -> None:
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    listed = out.split("distributions")[1]
+    for name in ("everyday", "hard"):
+        assert f"{name:<16} boards: hovershoes, segway, skateboard" in listed

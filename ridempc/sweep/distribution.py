@@ -79,6 +79,7 @@ __all__ = [
     "Payload",
     "Push",
     "StartOffsets",
+    "distribution_boards",
     "distribution_files",
     "distribution_names",
     "load_distribution",
@@ -430,6 +431,17 @@ def distribution_names(board: str | None = None) -> tuple[str, ...]:
     name when ``board`` is None."""
     patterns = ["**/*.toml"] if board is None else ["*.toml", f"{board}/*.toml"]
     return tuple(sorted({p.stem for pattern in patterns for p in DISTRIBUTIONS_DIR.glob(pattern)}))
+
+
+def distribution_boards(name: str) -> tuple[str, ...]:
+    """The boards the shipped distribution ``name`` is for (every board for one in the
+    folder's top level)."""
+    from ridempc.boards import board_names
+
+    boards = [b for b in board_names() if b != "none"]
+    if (DISTRIBUTIONS_DIR / f"{name}.toml").exists():
+        return tuple(boards)
+    return tuple(b for b in boards if (DISTRIBUTIONS_DIR / b / f"{name}.toml").exists())
 
 
 def distribution_files() -> tuple[Path, ...]:
