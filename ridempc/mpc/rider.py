@@ -53,7 +53,8 @@ Every 2 ms (500 Hz) the rider
    schedule puts on the ground (a push-off) stands on the ground for the WBC and the
    estimator, not on the board; a foot it lifts is left out of the board's estimate even
    if it touches something;
-4. sends the QP's torques as feedforward with its joint targets to the motor PD, at the
+4. sends the QP's torques as feedforward, each led over its motor's torque delay
+   (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD, at the
    robot's ``tracking_gain_scale`` of its default gains.
 
 **Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
@@ -122,6 +123,7 @@ from ridempc.wbc.controller import motor_posture
 from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.settings import WbcSettings
+from ridempc.wbc.torque_lead import TorqueLead
 
 __all__ = ["MpcRider", "platform_feet", "rolling_platforms"]
 
@@ -297,6 +299,7 @@ class MpcRider(Controller):
         scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
         self.kp = scale * np.array([m.kp for m in robot.motors])
         self.kd = scale * np.array([m.kd for m in robot.motors])
+        self.torque_lead = TorqueLead(robot, self.wbc.settings.dt)  # sent ahead of the delay
         self._contact_foot = self._contacts_to_feet(reference.contact_names)
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
@@ -387,6 +390,7 @@ class MpcRider(Controller):
     def reset(self, sensors: SensorPacket) -> None:
         self.estimator.reset(sensors)
         self.map.reset()
+        self.torque_lead.reset()
         self._tick = 0
         self._plan = None
         estimate = self.estimator.state
@@ -849,7 +853,8 @@ class MpcRider(Controller):
             self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
         self._diagnostics.update(wbc_ms=self._wbc_ms[-1])
-        return to_motor_command(out, self.kp, self.kd)
+        command = to_motor_command(out, self.kp, self.kd)
+        return replace(command, torque=self.torque_lead(now, command.torque))
 
     # ------------------------------------------------------------------ reports
 
