@@ -55,7 +55,10 @@ Every 2 ms (500 Hz) the rider
    if it touches something;
 4. sends the QP's torques as feedforward, each led over its motor's torque delay
    (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD, at the
-   robot's ``tracking_gain_scale`` of its default gains.
+   robot's ``tracking_gain_scale`` of its default stiffnesses; a delayed motor's damping is
+   the one of largest phase margin for that stiffness at the joint's inertia in the riding
+   posture (:func:`~ridempc.robots.delay_margin.tracking_damping`), the others' the same
+   scale of their default damping.
 
 **Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
 fallback, counted); if the WBC fails, its last command is sent again for up to
@@ -109,9 +112,11 @@ from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
+from ridempc.robots.delay_margin import tracking_damping
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
@@ -298,7 +303,14 @@ class MpcRider(Controller):
         self.force_filter = ForceFilter(tau) if tau is not None else None
         scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
         self.kp = scale * np.array([m.kp for m in robot.motors])
-        self.kd = scale * np.array([m.kd for m in robot.motors])
+        self.kd = tracking_damping(  # each delayed loop damped at its largest margin
+            robot.mj_model,
+            robot.ride_qpos(board),
+            robot.motors,
+            self.kp,
+            scale * np.array([m.kd for m in robot.motors]),
+            1.0 / DEFAULT_PHYSICS_HZ,
+        )
         self.torque_lead = TorqueLead(robot, self.wbc.settings.dt)  # sent ahead of the delay
         self._contact_foot = self._contacts_to_feet(reference.contact_names)
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then

@@ -14,7 +14,9 @@ whose phase margin at the crossover :math:`\\omega_c` (:math:`|L(j\\omega_c)| = 
 The delay costs :math:`\\omega_c T` of phase at the crossover, so the crossover, set mostly by
 :math:`k_d / I`, has to stay well below :math:`1/T`; the stiffness spends the damping's lead.
 :func:`phase_margin` evaluates the margin of given gains; :func:`gain_bound` gives the largest
-gains with a wanted margin and a wanted ratio of damping lead. The delay :math:`T` counts the
+gains with a wanted margin and a wanted ratio of damping lead; :func:`best_damping` the damping
+of largest margin for a given stiffness, and :func:`tracking_damping` that damping for each
+delayed motor of a robot at one configuration. The delay :math:`T` counts the
 delay line's whole steps and half a physics step of hold (:func:`effective_delay`).
 """
 
@@ -26,7 +28,17 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["effective_delay", "gain_bound", "joint_inertias", "phase_margin"]
+from ridempc.robots.robot import Motor
+from ridempc.sim.motors import delay_steps
+
+__all__ = [
+    "best_damping",
+    "effective_delay",
+    "gain_bound",
+    "joint_inertias",
+    "phase_margin",
+    "tracking_damping",
+]
 
 Array = NDArray[np.float64]
 
@@ -94,3 +106,68 @@ def joint_inertias(model: mujoco.MjModel, data: mujoco.MjData, dofs: NDArray[np.
     solved = np.zeros_like(unit)
     mujoco.mj_solveM(model, data, solved, unit)
     return 1.0 / solved[np.arange(len(dofs)), dofs]
+
+
+def best_damping(inertia: float, kp: float, delay: float) -> float:
+    """The damping of largest phase margin for a stiffness through a delay [N m s / rad].
+
+    With the crossover :math:`\\omega_c` as the free variable (:math:`k_d = I \\sqrt{\\omega_c^4
+    - a^2} / \\omega_c`, :math:`a = k_p / I`) the margin is :math:`\\varphi_m = \\arccos(a /
+    \\omega_c^2) - \\omega_c T`; it is largest where its slope is zero,
+
+    .. math:: T^2 x^3 - T^2 a^2 x - 4 a^2 = 0, \\qquad x = \\omega_c^2,
+
+    whose one root above :math:`a` gives :math:`k_d = I \\sqrt{(x^2 - a^2) / x}`. More damping
+    than this pushes the crossover out where the delay takes more than the damping gives.
+
+    Args:
+        inertia: Joint inertia :math:`I` [kg m^2].
+        kp: Stiffness [N m / rad] (> 0).
+        delay: Delay :math:`T` [s] (> 0).
+
+    Returns:
+        The damping :math:`k_d` [N m s / rad].
+    """
+    a = kp / inertia
+    roots = np.roots([delay**2, 0.0, -(delay**2) * a**2, -4.0 * a**2])
+    x = max(float(r.real) for r in roots if abs(r.imag) <= 1e-9 * abs(r))
+    return inertia * math.sqrt((x * x - a * a) / x)
+
+
+def tracking_damping(
+    model: mujoco.MjModel,
+    qpos: Array,
+    motors: tuple[Motor, ...],
+    kp: Array,
+    kd: Array,
+    timestep: float,
+) -> Array:
+    """Each motor's damping for its stiffness ``kp``: the largest margin through its delay.
+
+    Each joint's inertia is taken at ``qpos`` with the rest of the robot free
+    (:func:`joint_inertias`), each delay as the driver applies it (:func:`effective_delay` of
+    the delay in whole steps of ``timestep``), and the damping is :func:`best_damping`. A motor
+    without a delay keeps its damping from ``kd``: with no delay more damping only adds margin.
+
+    Args:
+        model: The robot's compiled description.
+        qpos: The configuration the robot works in [MuJoCo qpos].
+        motors: Its motors (actuator order).
+        kp: Their stiffnesses [N m / rad].
+        kd: Their dampings without a delay [N m s / rad].
+        timestep: The physics step the drivers run at [s].
+
+    Returns:
+        The dampings [N m s / rad], actuator order.
+    """
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, m.joint) for m in motors]
+    inertias = joint_inertias(model, data, np.array([model.jnt_dofadr[j] for j in joints]))
+    damping = np.array(kd, dtype=float)
+    for i, motor in enumerate(motors):
+        if motor.torque_delay > 0.0 and kp[i] > 0.0:
+            delay = effective_delay(delay_steps(motor.torque_delay, timestep), timestep)
+            damping[i] = best_damping(float(inertias[i]), float(kp[i]), delay)
+    return damping
