@@ -120,8 +120,10 @@ def run(args: argparse.Namespace) -> int:
         finally:
             progress.close(finished)
         elapsed = time.perf_counter() - started
-    finally:
-        engine.close()
+    except BaseException:  # an interrupt, an error: the rides under way are not waited for
+        engine.stop()
+        raise
+    engine.close()
     results = sweep_results(plan.header(), plan.records(), controllers, summaries)
     write_report(results, layout.folder)
     atomic_write_json(layout.sweep_json, results)  # last: its presence says the sweep is whole

@@ -23,10 +23,12 @@ wheels are a few MB against Ray's ~70 MB; the per-task overhead of both (2.5 ms 
 from __future__ import annotations
 
 import logging
-from contextlib import suppress
+import sys
+import threading
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import suppress
 from typing import Any, Protocol, TypeVar
 
 from ridempc.errors import ConfigError
@@ -40,7 +42,9 @@ ENGINES: tuple[str, ...] = ("local", "dask")
 # [s] to reach a scheduler given by --address: a live one on a LAN answers in milliseconds.
 CONNECT_TIMEOUT_S: float = 5.0
 # [s] for a cluster to close on an interrupt: within the command's second.
-_STOP_S: float = 0.3
+_STOP_S: float = 0.2
+# The resource tracker's warning of semaphores it removes because their process was ended.
+_QUIET_TRACKER: str = "ignore::UserWarning:multiprocessing.resource_tracker"
 _CLUSTER_HINT = 'pip install "ridempc[cluster]"'
 
 
@@ -112,6 +116,7 @@ class DaskEngine:
                 f"--engine dask: Dask is not installed; allowed: {_CLUSTER_HINT}, or --engine local"
             ) from None
         self._cluster = None
+        _start_resource_tracker()
         if address is None:
             self._cluster = LocalCluster(
                 n_workers=workers,
@@ -152,6 +157,23 @@ class DaskEngine:
         self._client.close()
         if self._cluster is not None:
             self._cluster.close()
+
+
+def _start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker from a thread that then ends.
+
+    The thread that starts the tracker is left with SIGINT and SIGTERM unblocked
+    (``resource_tracker.ensure_running`` blocks them around the spawn, then unblocks them).
+    Started by Dask's event-loop thread, that thread would take the signals meant for the
+    command's watcher (:mod:`ridempc.interrupts`).
+    """
+    from multiprocessing import resource_tracker
+
+    if _QUIET_TRACKER not in sys.warnoptions:  # passed on to the tracker as its -W flag
+        sys.warnoptions.append(_QUIET_TRACKER)
+    starter = threading.Thread(target=resource_tracker.ensure_running, name="ridempc-tracker")
+    starter.start()
+    starter.join()
 
 
 def make_engine(name: str, workers: int, address: str | None) -> Engine:

@@ -163,14 +163,16 @@ def _quantity_sections(results: Mapping[str, Any]) -> list[_Section]:
         bins = _bins(values)
         rows = [[name, "variants", *controllers]]
         fig, ax = plt.subplots(figsize=(6.0, 3.0))
-        for c in controllers:
+        width = bins[0][1] - bins[0][0]
+        for j, c in enumerate(controllers):  # side by side within each bin
+            dodge = width * 0.1 * (j - (len(controllers) - 1) / 2)
             kept = np.array([survived(v["summaries"][c]) for v in drawn])
             centres, rates, errors = [], [], []
             for low, high, members in bins:
                 n, k = int(members.sum()), int(kept[members].sum())
                 if n:
                     lo, hi = wilson(k, n)
-                    centres.append(0.5 * (low + high))
+                    centres.append(0.5 * (low + high) + dodge)
                     rates.append(k / n)
                     errors.append((k / n - lo, hi - k / n))
             ax.errorbar(centres, rates, yerr=np.array(errors).T, marker="o", capsize=4, label=c)
@@ -261,8 +263,9 @@ def _worst_section(results: Mapping[str, Any], folder: Path) -> _Section:
                 outcome = "rode" + ("" if rmse is None else f", velocity RMSE {rmse:.3g} m/s")
             drawn = ", ".join(f"{k} {x:.4g}" for k, x in sorted(v["drawn"].items()))
             rows.append([c, v["id"], str(v["seed"]), outcome, drawn or "-"])
+            commands.append(f"# {c} {v['id']}: {outcome}")
             commands.append(replay_command(results, v, c, folder))
-    text = "Each ride again, with its log and plots (the commands below, in row order)."
+    text = "Each ride again, with its log and plots: the commands below."
     return _Section("Worst rides", text, rows=rows, commands=commands)
 
 

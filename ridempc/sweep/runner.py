@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MAX_ATTEMPTS",
+    "POLL_S",
     "RideListener",
     "RideTask",
     "failed_summary",
@@ -45,6 +46,10 @@ __all__ = [
 # Tries of a ride whose worker dies under it: once is chance (another ride's worker, the
 # machine's memory), three times is the ride.
 MAX_ATTEMPTS: int = 3
+# [s] the longest the main thread waits for a ride without running Python: a SIGINT taken
+# by a thread that does not block it (OpenBLAS's, started when NumPy was imported, before
+# the command blocked the signals) raises the interrupt in the main thread only then.
+POLL_S: float = 0.1
 # ru_maxrss is in KiB on Linux and in bytes on macOS.
 _RSS_UNIT: int = 1 if sys.platform == "darwin" else 1024
 
@@ -196,7 +201,7 @@ def run_rides(
                 lost([task, *running.values()])
                 running.clear()
                 continue
-            done, _ = wait(list(running), return_when=FIRST_COMPLETED)
+            done, _ = wait(list(running), timeout=POLL_S, return_when=FIRST_COMPLETED)
             dead: list[RideTask] = []
             for future in done:
                 task = running.pop(future)
