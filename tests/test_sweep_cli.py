@@ -154,3 +154,20 @@ def test_an_interrupt_keeps_the_finished_rides_and_claims_nothing(tmp_path: Path
     for ride in rides:
         assert json.loads(ride.read_text())["status"] == "ok"  # each a whole file
     assert not list(out.glob("rides/*/.*.tmp"))
+
+
+def test_compare_rides_through_the_runner_with_workers(tmp_path: Path, capsys) -> None:
+    args = ["compare", "--robot", "cyberdog2", "--board", "none", "--scenario", "stand-still",
+            "--controllers", "stand,pd", "--seeds", "2", "--duration", "0.5"]  # fmt: skip
+    assert main([*args, "--out", str(tmp_path / "one")]) == 0
+    assert main([*args, "--workers", "2", "--out", str(tmp_path / "two")]) == 0
+    capsys.readouterr()
+    for controller in ("stand", "pd"):
+        for seed in (0, 1):
+            one, two = (
+                json.loads(
+                    (tmp_path / n / controller / f"seed-{seed}" / "summary.json").read_text()
+                )
+                for n in ("one", "two")
+            )
+            assert deterministic(one) == deterministic(two) and one["worker_peak_rss_mib"] > 0.0

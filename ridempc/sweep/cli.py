@@ -136,7 +136,8 @@ def run(args: argparse.Namespace) -> int:
 def _throughput(
     ridden: int, elapsed: float, slots: int, summaries: dict[tuple[str, str], dict[str, Any]]
 ) -> str:
-    """Rides per hour, and the sweep's own time per ride beyond the rides' simulation."""
+    """Rides per hour, and the time per ride spent besides simulating (each ride's setup,
+    a new worker's imports, the sweep's own work)."""
     if ridden == 0:
         return "every ride was already recorded: nothing ridden"
     ride_time = sorted(float(s.get("wall_time_s") or 0.0) for s in summaries.values())
@@ -144,5 +145,6 @@ def _throughput(
     overhead = elapsed * min(slots, ridden) / ridden - mean_ride
     return (
         f"{ridden} rides in {elapsed:.1f} s on {slots} worker(s): {3600.0 * ridden / elapsed:.0f} "
-        f"rides/h; {overhead:.2f} s per ride beyond the simulation (mean {mean_ride:.2f} s)"
+        f"rides/h; {overhead:.2f} s per ride besides simulating (mean simulation "
+        f"{mean_ride:.2f} s)"
     )

@@ -13,11 +13,12 @@ Both are :class:`Engine` objects handing out ``concurrent.futures`` futures, so 
   (up to Dask's ``allowed-failures``, then the ride is recorded as failed).
 
 Why Dask rather than Ray (measured on the 2-core development machine, 2 workers, Python
-3.11, Dask/distributed 2026.8.0, Ray 2.60.0; ``docs/sweeps.md`` has the commands):
-a local Dask cluster starts in 1.5 s against Ray's 4.0 s, holds 0.2 GiB against Ray's
-0.8 GiB in its own processes (raylet, GCS, dashboard agents) beside the workers, and its
-wheels are a few MB against Ray's ~70 MB; the per-task overhead of both (2.5 ms and
-1.0 ms for a trivial task) is nothing beside a ride of seconds.
+3.11, distributed 2026.8.0, Ray 2.60.0; ``docs/sweeps.md`` has the commands and the table):
+a local Dask cluster starts in 1.5 s against Ray's 4.0 s, it and its workers hold 0.2 GiB
+against Ray's 0.8 GiB (raylet, GCS server, agents), and it installs 24 MB against Ray's
+240 MB; the per-task overhead of both (2.5 ms and 0.9 ms for a trivial task, 0.06 s and
+0.08 s per 1.5 s ride) is nothing beside a ride. Its executor hands out standard
+``concurrent.futures`` futures, so the runner needs nothing of Dask's own.
 """
 
 from __future__ import annotations

@@ -121,18 +121,24 @@ def _pyplot() -> Any:
     return plt
 
 
+def _bar(rate: float, low: float, high: float) -> tuple[float, float]:
+    """An interval as error-bar lengths below and above the rate; never negative (at 0 or
+    n of n survivals, the bound and the rate differ in their last bits)."""
+    return max(0.0, rate - low), max(0.0, high - rate)
+
+
 def _survival_section(results: Mapping[str, Any]) -> _Section:
     plt = _pyplot()
     names = list(results["controllers"])
     rates = [results["controllers"][c]["survival_rate"] for c in names]
-    lows = [
-        r - results["controllers"][c]["survival_ci95"][0] for c, r in zip(names, rates, strict=True)
-    ]
-    highs = [
-        results["controllers"][c]["survival_ci95"][1] - r for c, r in zip(names, rates, strict=True)
-    ]
+    bars = np.array(
+        [
+            _bar(r, *results["controllers"][c]["survival_ci95"])
+            for c, r in zip(names, rates, strict=True)
+        ]
+    )
     fig, ax = plt.subplots(figsize=(1.6 + 1.2 * len(names), 3.2))
-    ax.bar(names, rates, yerr=[lows, highs], capsize=6, color="tab:blue", alpha=0.7)
+    ax.bar(names, rates, yerr=bars.T, capsize=6, color="tab:blue", alpha=0.7)
     ax.set_ylim(0.0, 1.05)
     ax.set_ylabel("survival [-]")
     ax.set_title("survival, 95 % Wilson interval")
@@ -174,7 +180,7 @@ def _quantity_sections(results: Mapping[str, Any]) -> list[_Section]:
                     lo, hi = wilson(k, n)
                     centres.append(0.5 * (low + high) + dodge)
                     rates.append(k / n)
-                    errors.append((k / n - lo, hi - k / n))
+                    errors.append(_bar(k / n, lo, hi))
             ax.errorbar(centres, rates, yerr=np.array(errors).T, marker="o", capsize=4, label=c)
         for low, high, members in bins:
             n = int(members.sum())
