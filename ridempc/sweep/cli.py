@@ -54,7 +54,8 @@ def add_parser(commands: Any) -> None:
         "--workers",
         type=options.bounded_int(1, options.MAX_JOBS),
         default=os.cpu_count() or 1,
-        help=f"worker processes, 1 to {options.MAX_JOBS} (default: this machine's cores)",
+        help=f"worker processes, 1 to {options.MAX_JOBS} (default: this machine's cores; with "
+        "--address, the cluster's own)",
     )
     sweep.add_argument("--engine", choices=ENGINES, default="local", help="local (default) or dask")
     sweep.add_argument(

@@ -111,12 +111,12 @@ def plan_sweep(
     out = writable_dir(Path(out), "--out folder")
     if not 1 <= samples <= MAX_SAMPLES:
         raise ConfigError(f"--samples {samples}: allowed: a whole number in [1, {MAX_SAMPLES}]")
+    base = _with_duration(resolve_scenario(scenario, board), duration)
+    drawn_from = load_distribution(distribution, board)  # the files first, then the scenes
     for controller in controllers:  # the pair, the scenario and the controllers, as sim does
         check_request(
             RideRequest(robot, board, controller, scenario, out=out, duration=duration, plots=False)
         )
-    base = _with_duration(resolve_scenario(scenario, board), duration)
-    drawn_from = load_distribution(distribution, board)
     manifest = SweepManifest(
         robot=robot,
         board=board,
