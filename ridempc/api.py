@@ -41,11 +41,12 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
+from numbers import Integral, Real
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ridempc.errors import ConfigError
-from ridempc.interrupts import Handling, handled
+from ridempc.interrupts import DEADLINE_S, Handling, handled
 from ridempc.options import MAX_SEED
 
 if TYPE_CHECKING:
@@ -98,9 +99,11 @@ def ride(
         ConfigError: Any other bad input (named with its value and what is allowed).
         Interrupted: SIGINT or SIGTERM during the ride. Called from a script's main thread
             with Python's own SIGINT handler in place, the ride takes the signals as
-            ``ridempc sim`` does (:func:`ridempc.interrupts.handled`): the process ends
-            within a second of the first one, with code 130 or 143. Elsewhere (the command
-            line, a worker process, another thread) the caller's handling stands.
+            ``ridempc sim`` does (:func:`ridempc.interrupts.handled`): the script's
+            ``finally`` blocks run, and the process ends with the command's one line and
+            code 130 or 143, at once if the script does not catch the interrupt, else
+            ``DEADLINE_S`` (0.4 s) after the signal. Elsewhere (the command line, a worker
+            process, another thread) the caller's handling stands.
     """
     from ridempc.run import RideRequest
     from ridempc.run import ride as ride_request
@@ -121,7 +124,7 @@ def ride(
         scenario=scenario,
         out=None if out is None else Path(out),
         duration=None if duration is None else float(duration),
-        seed=seed,
+        seed=int(seed),
         plots=plots and out is not None,
         ground_truth=bool(ground_truth),
     )
@@ -131,11 +134,13 @@ def ride(
 
 
 def _is_int(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
+    """An integer, NumPy's too, never a bool."""
+    return isinstance(value, Integral) and not isinstance(value, bool)
 
 
 def _is_number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
+    """A real number, NumPy's too, never a bool."""
+    return isinstance(value, Real) and not isinstance(value, bool)
 
 
 def _check_plain(**names: object) -> None:
@@ -149,9 +154,11 @@ def _signals_taken(unwritten: str) -> Iterator[None]:
     """SIGINT and SIGTERM raise :class:`~ridempc.interrupts.Interrupted` during the ride,
     where no one else takes them (see :func:`ride`).
 
-    The process then ends as ``ridempc`` does: the watcher ends it ``DEADLINE_S`` after the
-    signal, and an interrupt the script does not catch ends it at once, with the command's
-    one line and code instead of a traceback (:data:`sys.excepthook`).
+    The process then ends as ``ridempc`` does, with the command's one line and code: an
+    interrupt the script does not catch at once, instead of a traceback
+    (:data:`sys.excepthook`), one it catches ``DEADLINE_S`` after it. (The signal watcher
+    would end it then too, but only when the signal reaches the watcher's thread: threads
+    that libraries started on import, before the ride blocked the signals, may take it.)
     """
     ours = (
         threading.current_thread() is threading.main_thread()
@@ -166,6 +173,9 @@ def _signals_taken(unwritten: str) -> Iterator[None]:
         except KeyboardInterrupt:
             if handling.received is not None:
                 sys.excepthook = _ends_quietly(handling, sys.excepthook)
+                ending = threading.Timer(DEADLINE_S, handling.exit_now, (handling.received, None))
+                ending.daemon = True
+                ending.start()
             raise
 
 
