@@ -24,7 +24,14 @@ from ridempc.io import atomic_write_text
 from ridempc.sweep.aggregate import SWEEP_METRICS
 from ridempc.sweep.stats import survived, wilson
 
-__all__ = ["MAX_BINS", "WORST_RIDES", "replay_command", "survival_table", "write_report"]
+__all__ = [
+    "MAX_BINS",
+    "WORST_RIDES",
+    "replay_command",
+    "survival_table",
+    "sweep_command",
+    "write_report",
+]
 
 MAX_BINS: int = 5  # bins per drawn quantity: 20 variants a bin at 100 samples
 WORST_RIDES: int = 5  # worst rides listed per controller
@@ -292,8 +299,21 @@ def _title(results: Mapping[str, Any]) -> str:
     )
 
 
-def _markdown(results: Mapping[str, Any], sections: Sequence[_Section]) -> str:
-    parts = [f"# {_title(results)}", "Plots: report.html."]
+def sweep_command(results: Mapping[str, Any], folder: Path) -> str:
+    """The ``ridempc sweep`` command that made (and resumes) this sweep."""
+    controllers = ",".join(results["controllers"])
+    words = ["ridempc", "sweep", "--robot", results["robot"], "--board", results["board"],
+             "--scenario", results["scenario"], "--distribution", results["distribution"],
+             "--samples", str(results["samples"]), "--controllers", controllers,
+             "--seed", str(results["seed"])]  # fmt: skip
+    if results.get("duration") is not None:
+        words += ["--duration", f"{results['duration']:g}"]
+    return shlex.join([*words, "--out", str(folder)])
+
+
+def _markdown(results: Mapping[str, Any], sections: Sequence[_Section], folder: Path) -> str:
+    command = sweep_command(results, folder)
+    parts = [f"# {_title(results)}", f"```sh\n{command}\n```", "Plots: report.html."]
     for s in sections:
         parts.append(f"## {s.title}")
         if s.text:
@@ -313,7 +333,7 @@ def _html_table(rows: Sequence[Sequence[str]]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def _html(results: Mapping[str, Any], sections: Sequence[_Section]) -> str:
+def _html(results: Mapping[str, Any], sections: Sequence[_Section], folder: Path) -> str:
     title = html.escape(_title(results))
     parts = [
         "<!DOCTYPE html><html><head><meta charset='utf-8'>",
@@ -322,6 +342,7 @@ def _html(results: Mapping[str, Any], sections: Sequence[_Section]) -> str:
         "padding:2px 8px;text-align:right}pre{background:#f4f4f4;padding:.5em;"
         "overflow-x:auto}</style></head><body>",
         f"<h1>{title}</h1>",
+        f"<pre>{html.escape(sweep_command(results, folder))}</pre>",
     ]
     for s in sections:
         parts.append(f"<h2>{html.escape(s.title)}</h2>")
@@ -349,5 +370,5 @@ def _html(results: Mapping[str, Any], sections: Sequence[_Section]) -> str:
 def write_report(results: Mapping[str, Any], folder: Path) -> None:
     """Write ``report.md`` and ``report.html`` into ``folder`` (atomically)."""
     sections = _sections(results, folder)
-    atomic_write_text(folder / "report.md", _markdown(results, sections))
-    atomic_write_text(folder / "report.html", _html(results, sections))
+    atomic_write_text(folder / "report.md", _markdown(results, sections, folder))
+    atomic_write_text(folder / "report.html", _html(results, sections, folder))
