@@ -12,6 +12,8 @@ import os
 import signal
 from pathlib import Path
 
+import pytest
+
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sweep.engines import LocalEngine
 from ridempc.sweep.runner import MAX_ATTEMPTS, RideTask, run_rides
@@ -128,9 +130,11 @@ def test_a_dead_worker_is_replaced_and_its_ride_redone(tmp_path: Path) -> None:
     assert _calls(tmp_path).count("v0001 pd") == 1  # the killed try wrote nothing
 
 
-def test_a_ride_that_always_kills_its_worker_is_failed(tmp_path: Path) -> None:
-    tasks = _tasks(tmp_path, 2, ("pd",))
-    summaries = _run(tasks, always_dying_ride, workers=1)
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_ride_that_always_kills_its_worker_is_failed(tmp_path: Path, workers: int) -> None:
+    tasks = _tasks(tmp_path, 3, ("pd",))
+    summaries = _run(tasks, always_dying_ride, workers=workers)
     assert summaries[("v0000", "pd")]["status"] == "failed"
     assert f"died {MAX_ATTEMPTS} times" in summaries[("v0000", "pd")]["error"]
-    assert summaries[("v0001", "pd")]["status"] == "ok"
+    others = [summaries[(f"v000{i}", "pd")]["status"] for i in (1, 2)]
+    assert others == ["ok", "ok"]  # those that shared the pool with it ride again, alone

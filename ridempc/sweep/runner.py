@@ -8,8 +8,9 @@ The one mechanism for riding many variants: ``ridempc sweep`` (drawn variants) a
   leaves none, and a run started again rides only the tasks whose file is missing.
 - A ride that raises is recorded with ``status: failed`` and its error; the others go on.
 - A worker that dies (killed, out of memory) is replaced (:meth:`Engine.replace`) and the
-  rides it may have been riding are submitted again; one whose worker died
-  :data:`MAX_ATTEMPTS` times is recorded as failed.
+  rides it may have been riding are submitted again, each alone on the engine (a broken
+  pool does not say whose worker died); one whose worker died :data:`MAX_ATTEMPTS` times
+  is recorded as failed.
 - Each summary carries the worker's peak resident memory, ``worker_peak_rss_mib`` [MiB].
 """
 
@@ -174,6 +175,9 @@ def run_rides(
     attempts: Counter[tuple[str, str]] = Counter()
     running: dict[Future[dict[str, Any]], RideTask] = {}
 
+    def suspect(task: RideTask) -> bool:
+        return attempts[(task.variant, task.controller)] > 0
+
     def record(task: RideTask, summary: dict[str, Any]) -> None:
         atomic_write_json(task.summary_path, summary)
         summaries[(task.variant, task.controller)] = summary
@@ -195,7 +199,9 @@ def run_rides(
         while pending or running:
             try:
                 while pending and len(running) < engine.slots:
-                    task = pending.popleft()
+                    if running and (suspect(pending[0]) or any(map(suspect, running.values()))):
+                        break  # a ride under which a worker died rides alone: if it dies
+                    task = pending.popleft()  # again, it is the one that kills its worker
                     running[engine.submit(ride, task)] = task
             except engine.broken:
                 lost([task, *running.values()])
