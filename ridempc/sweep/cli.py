@@ -111,7 +111,12 @@ def run(args: argparse.Namespace) -> int:
         layout.start(plan.manifest)
         for variant in plan.variants:
             layout.write_variant(variant["id"], variant["toml"])
-        done = [s for t in plan.tasks if (s := read_summary(t.summary_path)) is not None]
+        recorded = {
+            (t.variant, t.controller): s
+            for t in plan.tasks
+            if (s := read_summary(t.summary_path)) is not None
+        }
+        done = list(recorded.values())
         progress = Progress(len(plan.tasks), controllers, done)
         started = time.perf_counter()
         finished = False
@@ -129,23 +134,21 @@ def run(args: argparse.Namespace) -> int:
     write_report(results, layout.folder)
     atomic_write_json(layout.sweep_json, results)  # last: its presence says the sweep is whole
     print(survival_table(results))
-    print(_throughput(len(plan.tasks) - len(done), elapsed, engine.slots, summaries))
+    ridden = [s for key, s in summaries.items() if key not in recorded]
+    print(_throughput(ridden, elapsed, engine.slots))
     print(f"results in {layout.folder} (report.md, report.html, sweep.json)")
     return EXIT_FAILED if results["failed"] else 0
 
 
-def _throughput(
-    ridden: int, elapsed: float, slots: int, summaries: dict[tuple[str, str], dict[str, Any]]
-) -> str:
+def _throughput(ridden: list[dict[str, Any]], elapsed: float, slots: int) -> str:
     """Rides per hour, and the time per ride spent besides simulating (each ride's setup,
-    a new worker's imports, the sweep's own work)."""
-    if ridden == 0:
+    a new worker's imports, the sweep's own work), over the rides of this run."""
+    if not ridden:
         return "every ride was already recorded: nothing ridden"
-    ride_time = sorted(float(s.get("wall_time_s") or 0.0) for s in summaries.values())
-    mean_ride = sum(ride_time) / len(ride_time)
-    overhead = elapsed * min(slots, ridden) / ridden - mean_ride
+    mean_ride = sum(float(s.get("wall_time_s") or 0.0) for s in ridden) / len(ridden)
+    overhead = elapsed * min(slots, len(ridden)) / len(ridden) - mean_ride
     return (
-        f"{ridden} rides in {elapsed:.1f} s on {slots} worker(s): {3600.0 * ridden / elapsed:.0f} "
-        f"rides/h; {overhead:.2f} s per ride besides simulating (mean simulation "
-        f"{mean_ride:.2f} s)"
+        f"{len(ridden)} rides in {elapsed:.1f} s on {slots} worker(s): "
+        f"{3600.0 * len(ridden) / elapsed:.0f} rides/h; {overhead:.2f} s per ride besides "
+        f"simulating (mean simulation {mean_ride:.2f} s)"
     )
