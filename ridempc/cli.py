@@ -24,6 +24,7 @@ from ridempc.errors import ConfigError, RidempcError, UnknownNameError
 from ridempc.interrupts import handled
 from ridempc.options import EXIT_BAD_INPUT
 from ridempc.paths import motion_library_dir
+from ridempc.sweep import cli as sweep_cli
 from ridempc.units import MAX_DURATION
 
 __all__ = ["main"]
@@ -88,6 +89,12 @@ def _parser() -> argparse.ArgumentParser:
         "--controllers", default="pd,mpc", help="comma-separated controllers (default: pd,mpc)"
     )
     compare.add_argument("--duration", type=options.duration, default=None, help=DURATION_HELP)
+    compare.add_argument(
+        "--workers",
+        type=options.bounded_int(1, options.MAX_JOBS),
+        default=1,
+        help=f"rides at once, 1 to {options.MAX_JOBS} (default: 1)",
+    )
     compare.add_argument("--out", type=options.path, required=True, help=OUT_HELP)
 
     bench = commands.add_parser(
@@ -148,6 +155,7 @@ def _parser() -> argparse.ArgumentParser:
         "--entry", type=options.entry_key, default=None, help="entry name or target, e.g. 0.5"
     )
     show.add_argument("--plot", type=options.path, default=None, help="write a PNG of the entry")
+    sweep_cli.add_parser(commands)
     return parser
 
 
@@ -189,6 +197,7 @@ def _compare(args: argparse.Namespace) -> int:
         seeds=args.seeds,
         controllers=controllers,
         duration=args.duration,
+        workers=args.workers,
     )
     print(f"results in {args.out}")
     failed = any(s["status"] == "failed" for r in rows for s in r.summaries)
@@ -291,6 +300,8 @@ def _unwritten(args: argparse.Namespace) -> str:
         return f"no summary.json was written in {args.out}"
     if args.command == "compare":
         return f"no comparison.json was written in {args.out} (nor the ride under way's summary)"
+    if args.command == "sweep":
+        return sweep_cli.unwritten(args)
     if args.command == "bench":
         return "no results" + (f" were written to {args.json}" if args.json else " were printed")
     if args.command == "board":
@@ -314,6 +325,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         return _compare(args)
     if args.command == "bench":
         return _bench(args)
+    if args.command == "sweep":
+        return sweep_cli.run(args)
     return _sim(args)
 
 

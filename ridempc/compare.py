@@ -19,7 +19,7 @@ JSON last; the files of an earlier comparison in the same folder are removed fir
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -31,7 +31,10 @@ from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.io import atomic_savefig, atomic_write_json, atomic_write_text
 from ridempc.options import MAX_SEEDS
 from ridempc.results import check_clearable, clear_results
-from ridempc.run import RideRequest, check_request, ride
+from ridempc.run import RideRequest, check_request
+from ridempc.scenarios import resolve_scenario
+from ridempc.sweep.engines import LocalEngine
+from ridempc.sweep.runner import RideTask, run_rides
 
 __all__ = ["COMPARED_METRICS", "ComparisonRow", "compare", "comparison_table"]
 
@@ -126,7 +129,13 @@ def _overlay(out: Path, rows: Sequence[ComparisonRow], title: str) -> None:
 
     from ridempc.sim.metrics import board_roll
 
-    logs = {r.controller: np.load(out / r.controller / "seed-0" / "log.npz") for r in rows}
+    logs = {
+        r.controller: np.load(out / r.controller / "seed-0" / "log.npz")
+        for r in rows
+        if (out / r.controller / "seed-0" / "log.npz").exists()  # (none if the ride raised)
+    }
+    if not logs:
+        return
     first = next(iter(logs.values()))
     rolled = "command_roll" in first and np.any(first["command_roll"] != 0.0)
     panels = ["forward_velocity", "yaw_rate"] + (["roll"] if rolled else [])
@@ -154,6 +163,17 @@ def _overlay(out: Path, rows: Sequence[ComparisonRow], title: str) -> None:
         plt.close(fig)
 
 
+class _Printer:
+    """One line per ride as it ends."""
+
+    def update(self, summary: Mapping[str, Any]) -> None:
+        print(
+            f"  {summary['controller']} seed {summary['seed']}: {summary['status']}"
+            + (f", fell at {summary['fall_time_s']:.2f} s" if summary["fell"] else ""),
+            flush=True,
+        )
+
+
 def compare(
     robot: str,
     board: str,
@@ -162,6 +182,7 @@ def compare(
     seeds: int = 1,
     controllers: Sequence[str] = ("pd", "mpc"),
     duration: float | None = None,
+    workers: int = 1,
 ) -> list[ComparisonRow]:
     """Ride ``scenario`` with each controller for seeds ``0 .. seeds-1`` and compare.
 
@@ -177,6 +198,7 @@ def compare(
         seeds: Number of seeds (at least 1).
         controllers: Controllers to compare (names from ``ridempc list``).
         duration: Override of the scenario's duration [s].
+        workers: Rides at once, each in its own worker process.
 
     Returns:
         One row per controller, in the given order.
@@ -212,19 +234,29 @@ def compare(
 
     for controller in controllers:  # every controller, pair and scenario before any ride
         check_request(request(controller, 0))
+    ridden = resolve_scenario(scenario, board)
+    tasks = [
+        RideTask(
+            variant=f"seed-{seed}",  # the unmodified scenario, one variant per seed
+            controller=controller,
+            robot=robot,
+            board=board,
+            scenario=ridden,
+            seed=seed,
+            summary_path=out / controller / f"seed-{seed}" / "summary.json",
+            out=out / controller / f"seed-{seed}",
+            duration=duration,
+        )
+        for controller in controllers
+        for seed in range(seeds)
+    ]
+    engine = LocalEngine(workers)  # a pool even of one: a ride that kills its worker is redone
     clear_results(out)
-    rows = []
-    for controller in controllers:
-        summaries = []
-        for seed in range(seeds):
-            summary = ride(request(controller, seed))
-            print(
-                f"  {controller} seed {seed}: {summary['status']}"
-                + (f", fell at {summary['fall_time_s']:.2f} s" if summary["fell"] else ""),
-                flush=True,
-            )
-            summaries.append(summary)
-        rows.append(_row(controller, summaries))
+    try:
+        summaries = run_rides(tasks, engine, _Printer())
+    finally:
+        engine.close()
+    rows = [_row(c, [summaries[(f"seed-{seed}", c)] for seed in range(seeds)]) for c in controllers]
     title = f"{robot} / {board} / {rows[0].summaries[0]['scenario']} ({seeds} seed(s))"
     table = comparison_table(rows)
     atomic_write_text(out / "comparison.md", f"# {title}\n\n{table}\n")

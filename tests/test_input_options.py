@@ -32,6 +32,10 @@ BENCH = ["bench", "--pairs", "cassie-segway"]
 IDENTIFY = ["board", "identify", "--board", "segway"]
 BUILD = ["library", "build", "--robot", "cyberdog2", "--board", "skateboard"]
 SHOW = ["library", "show", "--robot", "cassie", "--board", "segway"]
+SWEEP = ["sweep", "--robot", "cassie", "--board", "hovershoes", "--samples", "2",
+         "--controllers", "pd"]  # fmt: skip
+SCENARIO = ["--scenario", "stand-still"]
+DISTRIBUTION = ["--distribution", "everyday"]
 
 
 @pytest.fixture(autouse=True)
@@ -110,6 +114,9 @@ PATH_ARGUMENTS = [
     (BUILD, "--out", "folder to write", []),
     (SHOW, "--dir", "folder to read", []),
     (SHOW + ["--entry", "0.5"], "--plot", "file to write", []),
+    (SWEEP + [*SCENARIO, *DISTRIBUTION], "--out", "folder to write", []),
+    (SWEEP + DISTRIBUTION, "--scenario", "file to read", ["--out", "{tmp}/o"]),
+    (SWEEP + SCENARIO, "--distribution", "file to read", ["--out", "{tmp}/o"]),
 ]
 
 
@@ -183,7 +190,8 @@ def test_bad_paths_are_refused_before_any_work(
 
 @pytest.mark.parametrize(
     ("command", "option", "extra"),
-    [a[:2] + (a[3],) for a in PATH_ARGUMENTS if a[1] != "--scenario"],  # a name or a path
+    [a[:2] + (a[3],) for a in PATH_ARGUMENTS if a[1] not in ("--scenario", "--distribution")],
+    # (a name or a path)
 )
 def test_an_empty_path_is_refused(capsys, tmp_path: Path, command, option, extra) -> None:
     extra = [a.replace("{tmp}", str(tmp_path)) for a in extra]

@@ -1,0 +1,53 @@
+"""sweep.json's figures and the report, from made-up summaries (no ride)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from ridempc.sweep.aggregate import sweep_results
+from ridempc.sweep.report import write_report
+
+HEADER = {"robot": "cassie", "board": "hovershoes", "scenario": "stand-still",
+          "distribution": "everyday", "seed": 0, "duration": None}  # fmt: skip
+
+
+def _results(pd_falls: set[int], mpc_falls: set[int], n: int = 10) -> dict:
+    variants = [
+        {"id": f"v{i:04d}", "seed": 100 + i, "drawn": {"push.magnitude": 0.1 * i},
+         "scenario_file": f"variants/v{i:04d}.toml"}
+        for i in range(n)
+    ]  # fmt: skip
+    summaries = {}
+    for c, falls in (("pd", pd_falls), ("mpc", mpc_falls)):
+        for i, v in enumerate(variants):
+            fell = i in falls
+            summaries[(v["id"], c)] = {
+                "controller": c, "seed": v["seed"], "status": "ok", "fell": fell,
+                "fall_time_s": 2.0 + i if fell else None, "velocity_rmse": 0.01 * (i + 1),
+                "worker_peak_rss_mib": 300.0,
+            }  # fmt: skip
+    return sweep_results(HEADER, variants, ["pd", "mpc"], summaries)
+
+
+@pytest.mark.parametrize(("pd_falls", "mpc_falls"), [(set(), set()), (set(range(10)), {1, 2})])
+def test_report_at_the_extremes(tmp_path: Path, pd_falls, mpc_falls) -> None:
+    results = _results(pd_falls, mpc_falls)
+    write_report(results, tmp_path)  # every or no ride survived: intervals touch 0 or 1
+    assert (tmp_path / "report.html").read_text().count("data:image/png;base64,") == 3
+    assert "ridempc sim --robot cassie" in (tmp_path / "report.md").read_text()
+
+
+def test_sweep_results_counts() -> None:
+    results = _results({7, 8, 9}, {8, 9, 0})
+    pd, mpc = results["controllers"]["pd"], results["controllers"]["mpc"]
+    assert (pd["survived"], mpc["survived"], pd["rides"]) == (7, 7, 10)
+    assert pd["survival_ci95"] == pytest.approx([0.3968, 0.8922], abs=1e-4)
+    assert results["paired"] == [{
+        "controllers": ["pd", "mpc"], "both_survived": 6, "only_pd_survived": 1,
+        "only_mpc_survived": 1, "neither_survived": 2, "mcnemar_p": 1.0,
+    }]  # fmt: skip
+    assert pd["metrics"]["velocity_rmse"]["median"] == pytest.approx(0.055)
+    assert pd["metrics"]["fall_time_s"]["rides"] == 3 and pd["worker_peak_rss_mib"] == 300.0
+    assert results["failed"] == 0 and len(results["variants"]) == 10
