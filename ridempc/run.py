@@ -1,6 +1,8 @@
 """One ride, start to finish: resolve names, build the scene, simulate, write the results.
 
-The output folder receives ``log.npz`` (time series), optionally ``video.mp4``,
+A request names its controller and scenario, or carries the objects themselves (the Python
+API, :mod:`ridempc.api`); without an output folder the ride writes nothing and only returns
+its summary. The output folder receives ``log.npz`` (time series), optionally ``video.mp4``,
 ``snapshots.png`` (a strip of still frames) and ``plots.png``, and last of all
 ``summary.json``. Everything is checked before anything is written (:func:`check_request`);
 every file is written atomically, and every file an earlier run wrote there is removed
@@ -18,37 +20,37 @@ from typing import TYPE_CHECKING, Any
 from ridempc.boards import NO_BOARD, load_board
 from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
+from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, WriteFailed
 from ridempc.io import atomic_write_json, atomic_write_npz
 from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
-from ridempc.scenarios import Scenario, resolve_scenario
+from ridempc.scenarios import Scenario, load_scenario_file, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
-from ridempc.sim.simulation import Simulation
+from ridempc.sim.simulation import RunResult, Simulation
 from ridempc.units import MAX_DURATION, MIN_DURATION
 
 if TYPE_CHECKING:
-    from ridempc.controllers.base import Controller
     from ridempc.robots.robot import Robot
     from ridempc.sim.scene import Scene
 
-__all__ = ["CheckedRide", "RideRequest", "check_request", "ride"]
+__all__ = ["CheckedRide", "RideRequest", "check_request", "controller_label", "ride"]
 
 DEFAULT_SCENARIO = "stand-still"
 
 
 @dataclass(frozen=True)
 class RideRequest:
-    """What ``ridempc sim`` asks for.
+    """What ``ridempc sim`` (or :func:`ridempc.api.ride`) asks for.
 
     Attributes:
         robot: Robot name.
         board: Board name (``none`` for flat ground).
-        controller: Controller name.
-        scenario: Scenario name or path of a scenario file.
-        out: Output folder.
+        controller: Controller name, or a controller object built for this robot and board.
+        scenario: Scenario name, path of a scenario file, or a scenario object.
+        out: Output folder, or None to write nothing (no video, snapshots or viewer then).
         duration: Override of the scenario's duration [s], or None.
         seed: Seed of all random draws.
         video: Render ``video.mp4``.
@@ -61,9 +63,9 @@ class RideRequest:
 
     robot: str
     board: str
-    controller: str
-    scenario: str
-    out: Path
+    controller: str | Controller
+    scenario: str | Path | Scenario
+    out: Path | None
     duration: float | None = None
     seed: int = 0
     video: bool = False
@@ -89,7 +91,7 @@ class CheckedRide:
         rider_height: Height of the rider's base at the start [m] (frames the cameras).
         frame_callbacks: Called with (model, data) at the frame rate, when the request
             renders or views anything; :func:`ride` adds its recorders here.
-        out: The output folder (writable, or creatable).
+        out: The output folder (writable, or creatable), or None: nothing is written.
     """
 
     robot: Robot | None
@@ -100,7 +102,7 @@ class CheckedRide:
     simulation: Simulation
     rider_height: float
     frame_callbacks: list[Callable[[Any, Any], None]]
-    out: Path
+    out: Path | None
 
 
 def check_request(request: RideRequest) -> CheckedRide:
@@ -113,11 +115,16 @@ def check_request(request: RideRequest) -> CheckedRide:
     Raises:
         UnknownNameError: A name that does not exist.
         ConfigError: An output folder that cannot be written, a malformed scenario or
-            parameter file, a duration out of range, or a scenario that does not apply to
-            the robot-board pair or its scene.
+            parameter file, a duration out of range, a scenario that does not apply to
+            the robot-board pair or its scene, or a controller object that is not a
+            :class:`~ridempc.controllers.base.Controller` built for this robot and board.
     """
-    out = writable_dir(Path(request.out), "--out folder")
-    check_clearable(out)
+    out = None
+    if request.out is not None:
+        out = writable_dir(Path(request.out), "--out folder")
+        check_clearable(out)
+    elif request.video or request.snapshots > 0 or request.viewer:
+        raise ConfigError("a video, snapshots or the viewer need an output folder (out)")
     if request.duration is not None and not MIN_DURATION <= request.duration <= MAX_DURATION:
         raise ConfigError(  # NaN fails the comparison too
             f"--duration {request.duration}: allowed: seconds in "
@@ -130,8 +137,8 @@ def check_request(request: RideRequest) -> CheckedRide:
     robot = None if request.robot == NO_ROBOT else load_robot(request.robot)
     board = load_board(request.board)
     board_name = board.name if board is not None else NO_BOARD
-    scenario = resolve_scenario(request.scenario, board_name)
-    controller = make_controller(request.controller, robot, board_name)
+    scenario = _scenario(request.scenario, board_name)
+    controller = _controller(request.controller, robot, board_name)
     if not scenario.applies_to(request.robot, board_name):
         raise ConfigError(
             f"scenario '{scenario.name}' does not apply to {request.robot} on board '{board_name}'"
@@ -181,12 +188,58 @@ def check_request(request: RideRequest) -> CheckedRide:
     )
 
 
+def _scenario(scenario: str | Path | Scenario, board: str) -> Scenario:
+    """The request's scenario: an object as it is, a path read, a name looked up."""
+    if isinstance(scenario, Scenario):
+        return scenario
+    if isinstance(scenario, Path):
+        return load_scenario_file(scenario)
+    if not isinstance(scenario, str):
+        raise ConfigError(
+            f"scenario {type(scenario).__name__}: allowed: a library name, a .toml path "
+            "or a ridempc.scenarios.Scenario"
+        )
+    return resolve_scenario(scenario, board)
+
+
+def _controller(controller: str | Controller, robot: Robot | None, board: str) -> Controller | None:
+    """The request's controller: a name made for the pair, an object checked against it."""
+    if isinstance(controller, str):
+        return make_controller(controller, robot, board)
+    if not isinstance(controller, Controller):
+        raise ConfigError(
+            f"controller {type(controller).__name__}: allowed: a controller name or an "
+            "instance of ridempc.controllers.base.Controller"
+        )
+    label = controller_label(controller)
+    if robot is None:
+        raise ConfigError(f"controller '{label}': a dead weight (robot '{NO_ROBOT}') takes none")
+    built_for = getattr(getattr(controller, "robot", None), "name", None)
+    if built_for != robot.name or getattr(controller, "board", None) != board:
+        raise ConfigError(
+            f"controller '{label}' was built for robot '{built_for}' on board "
+            f"'{getattr(controller, 'board', None)}'; allowed: one built for robot "
+            f"'{robot.name}' on board '{board}'"
+        )
+    return controller
+
+
+def controller_label(controller: str | Controller) -> str:
+    """A controller as ``summary.json`` names it: its name, or an object's ``name``
+    attribute, else its class name."""
+    if isinstance(controller, str):
+        return controller
+    name = getattr(controller, "name", None)
+    return name if isinstance(name, str) and name else type(controller).__name__
+
+
 def ride(request: RideRequest) -> dict[str, Any]:
     """Run one ride and write its results; returns the summary.
 
     Every file an earlier ``sim`` or ``compare`` wrote in the output folder is removed once
     everything is checked (:func:`check_request`), before the ride starts
-    (:func:`~ridempc.results.clear_results`); nothing else there is touched.
+    (:func:`~ridempc.results.clear_results`); nothing else there is touched. Without an
+    output folder (``request.out`` None) nothing is written at all.
 
     Raises:
         UnknownNameError: A name that does not exist (before anything is written).
@@ -194,11 +247,15 @@ def ride(request: RideRequest) -> dict[str, Any]:
     """
     checked = check_request(request)
     robot, board_name, scenario = checked.robot, checked.board_name, checked.scenario
-    controller, scene, simulation = checked.controller, checked.scene, checked.simulation
+    scene, simulation = checked.scene, checked.simulation
     height = checked.rider_height  # frame the rider by its height
     frame_callbacks = checked.frame_callbacks
 
+    label = controller_label(request.controller)
     out = checked.out  # nothing is removed or written before this point
+    if out is None:
+        result = simulation.run()
+        return _summary(request, checked, result, label, files=[])
     clear_results(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -258,17 +315,25 @@ def ride(request: RideRequest) -> dict[str, Any]:
     if request.plots and result.log:
         from ridempc.sim.plots import plot_run
 
-        title = (
-            f"{request.robot} / {board_name} / {request.controller} / {scenario.name} "
-            f"(seed {request.seed})"
-        )
+        title = f"{request.robot} / {board_name} / {label} / {scenario.name} (seed {request.seed})"
         plot_run(result.log, robot, out / "plots.png", title)
         files.append("plots.png")
 
-    summary: dict[str, Any] = {
+    summary = _summary(request, checked, result, label, files)
+    atomic_write_json(out / "summary.json", summary)
+    return summary
+
+
+def _summary(
+    request: RideRequest, checked: CheckedRide, result: RunResult, label: str, files: list[str]
+) -> dict[str, Any]:
+    """The ride's ``summary.json`` (README: what a run writes)."""
+    scenario, controller, scene = checked.scenario, checked.controller, checked.scene
+    robot = checked.robot
+    return {
         "robot": request.robot,
-        "board": board_name,
-        "controller": request.controller,
+        "board": checked.board_name,
+        "controller": label,
         "scenario": scenario.name,
         "seed": request.seed,
         "status": result.status,
@@ -291,5 +356,3 @@ def ride(request: RideRequest) -> dict[str, Any]:
         **(controller.summary() if controller is not None else {}),
         "files": files,
     }
-    atomic_write_json(out / "summary.json", summary)
-    return summary
