@@ -3,7 +3,10 @@ tiny real search through the command line."""
 
 from __future__ import annotations
 
+import json
 import math
+import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -13,6 +16,7 @@ from ridempc.sweep.bisection import Outcome, Search, find_margin
 from ridempc.sweep.margin import MarginSpec, run_margin
 from ridempc.sweep.pushes import directions, pushed_scenario
 from tests.test_cli import _run
+from tests.test_interrupts import SETTLE_S, _assert_interrupted, _start, _stop, _wait_for
 
 SEARCH = Search(tolerance=0.1, start=1.0, cap=32.0, checks=2)
 
@@ -153,3 +157,77 @@ def test_an_unwritable_out_is_one_line_and_exit_2(capsys, tmp_path: Path) -> Non
     taken.write_text("not a folder")
     code, _, err = _run(capsys, *BASE, "--out", str(taken))
     assert code == 2 and len(err.strip().splitlines()) == 1 and str(taken) in err
+
+
+@pytest.fixture
+def fake_rides(monkeypatch) -> None:
+    """Every ride of the command is :func:`_fake_ride` (no simulation)."""
+    monkeypatch.setattr("ridempc.sweep.margin.ride_pushed", _fake_ride)
+
+
+def test_the_command_writes_the_margins_every_ride_and_the_plot(
+    capsys, tmp_path: Path, fake_rides
+) -> None:
+    out = tmp_path / "m"
+    code, printed, err = _run(
+        capsys, *BASE, "--directions", "4", "--workers", "2", "--out", str(out)
+    )
+    assert code == 0, err
+    payload = json.loads((out / "margin.json").read_text())
+    assert payload["margins"].keys() == {"0", "90", "180", "270"}
+    assert 1.9 <= payload["margins"]["0"] <= 2.0 and 0.9 <= payload["margins"]["90"] <= 1.0
+    assert payload["push_duration_s"] == 0.2 and payload["tolerance"] == 0.1
+    assert (payload["robot"], payload["board"], payload["controller"]) == BASE[2::2]
+    assert payload["scenario"] == "stand-still" and payload["seed"] == 0
+    assert all(payload["monotone"].values()) and payload["failed_rides"] == 0
+    for key, rides in payload["rides"].items():
+        assert {r["survived"] for r in rides} == {True, False}
+        for r in rides:  # each ride replays from its scenario file
+            scenario = resolve_scenario(str(out / r["scenario_file"]))
+            assert scenario == pushed_scenario(
+                resolve_scenario("stand-still", "hovershoes"), float(key), r["magnitude"]
+            )
+    assert (out / "margin.png").read_bytes().startswith(b"\x89PNG")
+    lines = printed.splitlines()
+    assert any(line.split()[:2] == ["90", f"{payload['margins']['90']:.2f}"] for line in lines)
+
+
+def test_a_second_run_replaces_the_first_ones_files(capsys, tmp_path: Path, fake_rides) -> None:
+    out = tmp_path / "m"
+    assert _run(capsys, *BASE, "--directions", "4", "--workers", "1", "--out", str(out))[0] == 0
+    notes = out / "notes.txt"
+    notes.write_text("mine")
+    assert _run(capsys, *BASE, "--directions", "1", "--workers", "1", "--out", str(out))[0] == 0
+    assert sorted(p.name for p in (out / "rides").iterdir()) == ["0", "unpushed.toml"]
+    assert json.loads((out / "margin.json").read_text())["margins"].keys() == {"0"}
+    assert notes.read_text() == "mine"
+
+
+def test_a_tiny_real_search_through_the_command_line(capsys, tmp_path: Path) -> None:
+    """The dog standing on the ground, two directions, half a second after the push, a coarse
+    tolerance: about ten one-second rides."""
+    out = tmp_path / "m"
+    argv = ["margin", "--robot", "cyberdog2", "--board", "none", "--controller", "stand"]
+    options = ["--directions", "2", "--push-time", "0.5", "--duration-after", "0.5"]
+    options += ["--tolerance", "4", "--checks", "0", "--workers", "1"]
+    code, _, err = _run(capsys, *argv, *options, "--out", str(out))
+    assert code == 0, err
+    payload = json.loads((out / "margin.json").read_text())
+    assert payload["unpushed"]["survived"] and payload["margins"].keys() == {"0", "180"}
+    for key, margin in payload["margins"].items():
+        rides = payload["rides"][key]
+        assert rides[0]["magnitude"] == 1.0 and rides[0]["survived"]  # the library's push
+        assert 1.0 <= margin <= 32.0
+
+
+@pytest.mark.parametrize(("signum", "workers"), [(signal.SIGINT, "2"), (signal.SIGTERM, "1")])
+def test_an_interrupted_search_writes_no_margin_json(
+    tmp_path: Path, signum: int, workers: str
+) -> None:
+    out = tmp_path / "m"
+    process = _start(*BASE, "--directions", "2", "--workers", workers, "--out", str(out))
+    _wait_for(out, process)  # made once everything is checked, before the first ride
+    time.sleep(SETTLE_S)
+    seconds, _, err = _stop(process, signum)
+    _assert_interrupted(process, seconds, err, signum, f"no margin.json was written in {out}")
+    assert not (out / "margin.json").exists()

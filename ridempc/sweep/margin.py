@@ -183,25 +183,30 @@ def run_margin(spec: MarginSpec, workers: int, ride: RidePush | None = None) -> 
 
 
 def check_spec(spec: MarginSpec) -> None:
-    """Every name and the pushed scenario checked, before any ride.
+    """Everything a ride of ``spec`` needs, checked before any ride: the names, the pair,
+    and the scenario with the largest push against the built scene
+    (:func:`ridempc.run.check_request`, as ``ridempc sim`` checks; ~1-2 s).
 
     Raises:
         UnknownNameError: A robot, board or controller that does not exist, or a pair the
             controller does not ride.
-        ConfigError: A scenario that does not apply to the pair, or that the push makes
-            invalid (a base event after the shortened ride's end).
+        ConfigError: A scenario that does not apply to the pair or its scene, or that the
+            push makes invalid (a base event after the shortened ride's end).
     """
-    from ridempc.boards import NO_BOARD, load_board
-    from ridempc.controllers import NO_ROBOT, make_controller
-    from ridempc.robots import load_robot
+    from ridempc.run import RideRequest, check_request
 
-    robot = None if spec.robot == NO_ROBOT else load_robot(spec.robot)
-    board = load_board(spec.board)
-    board_name = board.name if board is not None else NO_BOARD
-    make_controller(spec.controller, robot, board_name)  # the pair's own checks (~1 s)
-    if not spec.scenario.applies_to(spec.robot, board_name):
+    if not spec.scenario.applies_to(spec.robot, spec.board):  # named as the user gave it
         raise ConfigError(
             f"--scenario {spec.scenario.name}: does not apply to {spec.robot} on board "
-            f"'{board_name}'"
+            f"'{spec.board}'"
         )
-    spec.pushed(0.0, spec.search.cap)
+    check_request(
+        RideRequest(
+            robot=spec.robot,
+            board=spec.board,
+            controller=spec.controller,
+            scenario=spec.pushed(0.0, spec.search.cap),
+            out=None,
+            seed=spec.seed,
+        )
+    )

@@ -127,6 +127,7 @@ def unwritten(args: argparse.Namespace) -> str:
 def run(args: argparse.Namespace) -> int:
     """Run ``ridempc margin``; its exit code (0, or 1 if a ride failed)."""
     from ridempc.boards import NO_BOARD, load_board
+    from ridempc.errors import WriteFailed
     from ridempc.scenarios import resolve_scenario
     from ridempc.sweep.bisection import Search
     from ridempc.sweep.margin import MarginSpec, check_spec, run_margin
@@ -157,6 +158,10 @@ def run(args: argparse.Namespace) -> int:
     )
     check_spec(spec)
     clear_margin(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # the folder changed since it was checked
+        raise WriteFailed(out, exc) from exc
     result = run_margin(spec, args.workers or os.cpu_count() or 1)
     write_margin(out, result)
     print(margin_table(result))

@@ -40,6 +40,8 @@ __all__ = [
 
 MARGIN_FILES: tuple[str, ...] = ("margin.json", "margin.png")  # margin.json first: see clear
 RIDES_DIR: str = "rides"
+# The rider's own words for the principal directions on the plot.
+_COMPASS: dict[int, str] = {0: "0° forward", 90: "90° left", 180: "180° back", 270: "270° right"}
 _DPI: int = 120  # a 6-inch plot at 720 pixels: readable on a screen and in a report
 
 
@@ -235,7 +237,9 @@ def plot_margin(result: MarginResult, path: Path) -> None:
     ax.set_theta_zero_location("E")  # 0°: forward, the rider's +x
     ax.set_theta_direction(1)
     ax.set_rlim(0.0, max(max(values), spec.search.tolerance) * 1.15)
-    ax.set_ylabel("N/kg", labelpad=24)
+    ax.set_xticks([math.radians(d) for d in range(0, 360, 45)])
+    ax.set_xticklabels([_COMPASS.get(d, f"{d}°") for d in range(0, 360, 45)])
+    ax.set_rlabel_position(22.5)  # the radial scale [N/kg] between the first two directions
     ax.set_title(
         f"{spec.robot} / {spec.board} / {spec.controller}: largest push survived [N/kg]\n"
         f"'{spec.scenario.name}', {PUSH_DURATION_S:g} s on the base, seed {spec.seed}",
