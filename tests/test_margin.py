@@ -220,6 +220,27 @@ def test_a_tiny_real_search_through_the_command_line(capsys, tmp_path: Path) -> 
         assert 1.0 <= margin <= 32.0
 
 
+def _crashing_ride(spec: MarginSpec, degrees: float, magnitude: float) -> Outcome:
+    """:func:`_fake_ride`, but the controller crashes on pushes of 1.5 N/kg and more."""
+    if magnitude >= 1.5:
+        return Outcome("failed", error="ValueError: the controller crashed")
+    return _fake_ride(spec, degrees, magnitude)
+
+
+def test_a_failed_ride_is_recorded_and_the_command_exits_1(
+    capsys, tmp_path: Path, monkeypatch
+) -> None:
+    monkeypatch.setattr("ridempc.sweep.margin.ride_pushed", _crashing_ride)
+    out = tmp_path / "m"
+    code, _, err = _run(capsys, *BASE, "--directions", "2", "--workers", "1", "--out", str(out))
+    assert code == 1 and err.startswith("ridempc: failed:") and "Traceback" not in err
+    payload = json.loads((out / "margin.json").read_text())
+    assert payload["failed_rides"] >= 2 and payload["margins"]["0"] < 1.5
+    failed = [r for r in payload["rides"]["0"] if r["status"] == "failed"]
+    assert failed and not any(r["survived"] for r in failed)
+    assert failed[0]["error"] == "ValueError: the controller crashed"
+
+
 @pytest.mark.parametrize(("signum", "workers"), [(signal.SIGINT, "2"), (signal.SIGTERM, "1")])
 def test_an_interrupted_search_writes_no_margin_json(
     tmp_path: Path, signum: int, workers: str

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from typing import Any
 
 from ridempc import options
@@ -166,4 +167,11 @@ def run(args: argparse.Namespace) -> int:
     write_margin(out, result)
     print(margin_table(result))
     print(f"results in {out}")
-    return 1 if result.failed else 0
+    if result.failed:
+        print(
+            f"ridempc: failed: {result.failed} ride(s) failed; their errors are in "
+            f"{out / 'margin.json'}",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
