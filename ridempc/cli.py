@@ -220,6 +220,7 @@ def _list() -> int:
     from ridempc.controllers import controller_names
     from ridempc.robots import robot_names
     from ridempc.scenarios import scenario_applies, scenario_names
+    from ridempc.sweep.distribution import distribution_boards, distribution_names
 
     print("robots:      " + ", ".join(robot_names()))
     print("boards:      " + ", ".join(board_names()))
@@ -236,6 +237,9 @@ def _list() -> int:
         if off:
             line += f" (does not apply to: {', '.join(off)})"
         print(line + f"; riders: {', '.join(robots)}")
+    print("distributions (what a sweep draws; a .toml path too):")
+    for name in distribution_names():
+        print(f"  {name:<16} boards: {', '.join(distribution_boards(name))}")
     return 0
 
 

@@ -164,3 +164,17 @@ def test_a_script_is_interrupted_as_the_command_is(signum: int, code: int) -> No
     assert "Traceback" not in err and "not interrupted" not in out
     name = signal.Signals(signum).name
     assert err == f"ridempc: interrupted ({name}); no summary returned\n"
+
+
+def test_the_summary_is_the_one_ridempc_sim_writes(tmp_path: Path, capsys) -> None:
+    from ridempc.cli import main
+
+    argv = ["sim", "--robot", "cassie", "--controller", "stand", "--scenario", "push"]
+    assert main([*argv, "--duration", str(SHORT), "--seed", "4", "--out", str(tmp_path)]) == 0
+    written = json.loads((tmp_path / "summary.json").read_text())
+    summary = ridempc.ride("cassie", "none", "stand", "push", duration=SHORT, seed=4)
+    timings = {"wall_time_s", "real_time_factor", "controller_update_ms", "files"}
+    assert set(summary) == set(written)
+    assert {k: v for k, v in summary.items() if k not in timings} == {
+        k: v for k, v in written.items() if k not in timings
+    }

@@ -1,0 +1,486 @@
+"""Distributions: which quantities a sweep draws for each variant of a scenario, and how.
+
+A distribution is a checked TOML file, shipped in ``ridempc/scenarios/distributions/``
+(``<board>/<name>.toml`` for one board, ``<name>.toml`` for any) or given by path. Each
+quantity is a number (fixed) or a law: ``{uniform = [low, high]}``, ``{normal = [mean, std],
+clip = [low, high]}`` (clipped to a physical range) or ``{choice = [a, b, ...]}`` (one of them,
+equally likely). Example::
+
+    name = "everyday"
+    board = "hovershoes"                     # omitted: any board
+
+    [[pushes]]                               # a horizontal push on the rider's base
+    magnitude = {uniform = [0.0, 1.0]}       # [N/kg] of the rider's mass
+    direction = {uniform = [0.0, 360.0]}     # [deg] world frame, 0 = +x (ahead at the start)
+    t = {uniform = [2.0, 8.0]}               # [s]
+    duration = {uniform = [0.1, 0.3]}        # [s]
+
+    [[kicks]]                                # a horizontal push on a board body
+    body = "left_shoe"
+    magnitude = {uniform = [0.0, 25.0]}      # [N]
+    direction = {uniform = [0.0, 360.0]}     # [deg]
+    t = {uniform = [2.0, 8.0]}               # [s]
+    duration = 0.1                           # [s]
+
+    [payload]                                # a point mass on a rider body
+    body = "base"
+    fraction = {uniform = [0.0, 0.1]}        # of the rider's mass [-]
+    offset = [0.0, 0.0, {uniform = [0.0, 0.1]}]   # body frame [m]
+
+    [start]                                  # added to the scenario's start offsets [m]
+    foot_offset = [{uniform = [-0.01, 0.01]}, {uniform = [-0.01, 0.01]}]
+    platform_offsets = [{uniform = [-0.015, 0.015]}, 0.0]   # each independent platform
+
+    [noise]                                  # the scenario's sensor noise scaled [-]
+    scale = {uniform = [1.0, 1.5]}           # every noise standard deviation
+    vio_latency_scale = {uniform = [1.0, 1.5]}
+
+    [[changes]]                              # a knob of a scenario's [[changes]]
+    parameter = "floor_friction"
+    value = {uniform = [0.6, 1.0]}           # or scale = ...; body, gain, joint as there
+    body = ["left_shoe", "right_shoe"]       # (board_mass, payload-free knobs) one draw each
+
+Every number is checked finite and within physical bounds, every range non-empty; a
+``[[changes]]`` entry is checked by the knob's own rules at both ends of its range. Each
+drawn quantity has a dotted name (:meth:`Distribution.quantities`), e.g.
+``push.magnitude``, ``kick.direction``, ``payload.offset.z``,
+``start.platform_offsets.1.x``, ``noise.scale``, ``changes.board_mass.left_shoe.scale``;
+an index follows ``push`` and ``kick`` where there are several (``push.0.t``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import (
+    AfterValidator,
+    BeforeValidator,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from ridempc.errors import ConfigError, UnknownNameError
+from ridempc.scenarios.scenario import ParameterChange
+from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX
+from ridempc.tomlfile import load_checked
+from ridempc.units import MAX_DURATION, CheckedModel, Real
+
+__all__ = [
+    "DISTRIBUTIONS_DIR",
+    "Distribution",
+    "DrawnChange",
+    "Kick",
+    "Law",
+    "NoiseScales",
+    "Payload",
+    "Push",
+    "StartOffsets",
+    "distribution_boards",
+    "distribution_files",
+    "distribution_names",
+    "load_distribution",
+]
+
+DISTRIBUTIONS_DIR = Path(__file__).resolve().parents[1] / "scenarios" / "distributions"
+
+_LAWS = ("fixed", "uniform", "normal", "choice")
+
+
+class Law(CheckedModel):
+    """How one quantity is drawn: exactly one of the fields below (a bare number in a file
+    is ``fixed``).
+
+    Attributes:
+        fixed: The value itself.
+        uniform: ``[low, high]``, drawn uniformly, ``low < high``.
+        normal: ``[mean, std]``, ``std > 0``, clipped to ``clip``.
+        clip: ``[low, high]`` for ``normal`` (required: a physical quantity is bounded).
+        choice: Values, one drawn with equal probability.
+    """
+
+    fixed: Real | None = None
+    uniform: tuple[Real, Real] | None = None
+    normal: tuple[Real, Real] | None = None
+    clip: tuple[Real, Real] | None = None
+    choice: tuple[Real, ...] | None = Field(None, min_length=1)
+
+    @model_validator(mode="after")
+    def _one_law(self) -> Law:
+        given = [law for law in _LAWS if getattr(self, law) is not None]
+        if len(given) != 1:
+            raise ValueError(
+                "allowed: a number, or exactly one of uniform = [low, high], "
+                "normal = [mean, std] with clip = [low, high], choice = [a, b, ...]"
+                + (f"; got {' and '.join(given)}" if given else "")
+            )
+        if self.uniform is not None and not self.uniform[0] < self.uniform[1]:
+            raise ValueError(
+                f"uniform = [{self.uniform[0]:g}, {self.uniform[1]:g}] is empty or inverted; "
+                "allowed: [low, high] with low < high"
+            )
+        if (self.clip is not None) != (self.normal is not None):
+            raise ValueError("clip = [low, high] goes with normal, and normal needs it")
+        if self.normal is not None and self.clip is not None:
+            mean, std = self.normal
+            low, high = self.clip
+            if not std > 0.0:
+                raise ValueError(f"normal std = {std:g}; allowed: above 0")
+            if not low < high or not low <= mean <= high:
+                raise ValueError(
+                    f"clip = [{low:g}, {high:g}] with mean {mean:g}; allowed: low < high "
+                    "and the mean between them"
+                )
+        return self
+
+    @property
+    def random(self) -> bool:
+        """Whether it varies from variant to variant."""
+        return self.fixed is None and not (self.choice is not None and len(set(self.choice)) < 2)
+
+    def bounds(self) -> tuple[float, float]:
+        """The lowest and highest value it can draw."""
+        if self.fixed is not None:
+            return self.fixed, self.fixed
+        if self.uniform is not None:
+            return self.uniform
+        if self.clip is not None:
+            return self.clip
+        assert self.choice is not None
+        return min(self.choice), max(self.choice)
+
+    def draw(self, rng: np.random.Generator) -> float:
+        """One value (a fixed one takes nothing from ``rng``)."""
+        if self.fixed is not None:
+            return float(self.fixed)
+        if self.uniform is not None:
+            return float(rng.uniform(*self.uniform))
+        if self.normal is not None and self.clip is not None:
+            return float(np.clip(rng.normal(*self.normal), *self.clip))
+        assert self.choice is not None
+        return float(self.choice[int(rng.integers(len(self.choice)))])
+
+
+def _number_is_fixed(value: Any) -> Any:
+    return value if isinstance(value, dict) else {"fixed": value}
+
+
+def _within(low: float, high: float, unit: str, low_open: bool = False) -> AfterValidator:
+    """A law whose every draw lies in ``[low, high]`` (``(low, high]`` with ``low_open``)."""
+
+    def check(law: Law) -> Law:
+        lo, hi = law.bounds()
+        if not ((lo > low if low_open else lo >= low) and hi <= high):
+            allowed = f"{'(' if low_open else '['}{low:g}, {high:g}]{unit and ' ' + unit}"
+            raise ValueError(f"draws in [{lo:g}, {hi:g}]; allowed: within {allowed}")
+        return law
+
+    return AfterValidator(check)
+
+
+Quantity = Annotated[Law, BeforeValidator(_number_is_fixed)]
+# A push of 100 N/kg (ten g) throws any of the robots: the scenario's bound on a push.
+PushMagnitude = Annotated[Quantity, _within(0.0, 100.0, "N/kg")]
+# A kick of 10 kN throws any board: the scenario's bound on a force.
+KickMagnitude = Annotated[Quantity, _within(0.0, 10_000.0, "N")]
+Direction = Annotated[Quantity, _within(-360.0, 360.0, "deg")]
+EventTime = Annotated[Quantity, _within(0.0, MAX_DURATION, "s")]
+# A push longer than 5 s is a load, not a push: the scenario's bound.
+PushDuration = Annotated[Quantity, _within(0.0, 5.0, "s", low_open=True)]
+# At most the rider's own mass again: more is a second rider, not a payload.
+MassFraction = Annotated[Quantity, _within(0.0, 1.0, "")]
+PayloadOffset = Annotated[Quantity, _within(-PAYLOAD_OFFSET_MAX, PAYLOAD_OFFSET_MAX, "m")]
+# A foot or platform moved by more than half a metre is off any deck: the scenario's bound.
+StartOffset = Annotated[Quantity, _within(-0.5, 0.5, "m")]
+# Ten times a sensor's noise or delay is a broken sensor, not a robustness study.
+NoiseScale = Annotated[Quantity, _within(0.0, 10.0, "", low_open=True)]
+
+
+class _Frozen(CheckedModel):
+    """Strict numbers, no NaN, no unknown keys, immutable."""
+
+
+class _Event(_Frozen):
+    """A horizontal force for a while.
+
+    Attributes:
+        direction: In the horizontal plane of the world frame, counter-clockwise from +x
+            (the rider's heading at the start) [deg].
+        t: When it starts [s].
+    """
+
+    direction: Direction = Law(fixed=0.0)
+    t: EventTime
+
+    def quantities(self, prefix: str) -> dict[str, Law]:
+        names = ("magnitude", "direction", "t", "duration")
+        return {f"{prefix}.{name}": getattr(self, name) for name in names}
+
+
+class Push(_Event):
+    """A horizontal push on the rider's base, per kg of its mass.
+
+    Attributes:
+        magnitude: [N/kg].
+        duration: How long it lasts [s] (the library's pushes: 0.2 s).
+    """
+
+    magnitude: PushMagnitude
+    duration: PushDuration = Law(fixed=0.2)
+
+
+class Kick(_Event):
+    """A horizontal push on a board body.
+
+    Attributes:
+        body: The board body (e.g. ``left_shoe``, ``chassis``, ``deck``).
+        magnitude: [N].
+        duration: How long it lasts [s] (the library's kicks: 0.1 s).
+    """
+
+    body: str = Field(min_length=1)
+    magnitude: KickMagnitude
+    duration: PushDuration = Law(fixed=0.1)
+
+
+class Payload(_Frozen):
+    """A point mass on a rider body (a ``payload`` change); none where its mass draws 0.
+
+    Attributes:
+        body: ``base`` or a body of the robot.
+        fraction: Its mass over the rider's [-].
+        offset: Its position in the body's frame [m].
+    """
+
+    body: str = "base"
+    fraction: MassFraction
+    offset: tuple[PayloadOffset, PayloadOffset, PayloadOffset] = (
+        Law(fixed=0.0),
+        Law(fixed=0.0),
+        Law(fixed=0.0),
+    )
+
+    def quantities(self) -> dict[str, Law]:
+        axes = {f"payload.offset.{a}": law for a, law in zip("xyz", self.offset, strict=True)}
+        return {"payload.fraction": self.fraction, **axes}
+
+
+class StartOffsets(_Frozen):
+    """Start offsets added to the scenario's own.
+
+    Attributes:
+        foot_offset: The feet off the platform centre, (x, y) [m].
+        platform_offsets: Each independent platform moved, (x, y) [m], drawn for each one
+            (boards with several platforms only: the Hovershoes).
+    """
+
+    foot_offset: tuple[StartOffset, StartOffset] = (Law(fixed=0.0), Law(fixed=0.0))
+    platform_offsets: tuple[StartOffset, StartOffset] | None = None
+
+    def quantities(self, platforms: int) -> dict[str, Law]:
+        axes = zip("xy", self.foot_offset, strict=True)
+        laws = {f"start.foot_offset.{axis}": law for axis, law in axes}
+        if self.platform_offsets is not None:
+            for i in range(platforms):
+                for axis, law in zip("xy", self.platform_offsets, strict=True):
+                    laws[f"start.platform_offsets.{i}.{axis}"] = law
+        return laws
+
+
+class NoiseScales(_Frozen):
+    """The scenario's sensor noise scaled.
+
+    Attributes:
+        scale: Every noise standard deviation (IMU, encoder velocities, torques, VIO) [-].
+        vio_latency_scale: The VIO's capture-to-delivery delay [-].
+    """
+
+    scale: NoiseScale = Law(fixed=1.0)
+    vio_latency_scale: NoiseScale = Law(fixed=1.0)
+
+    def quantities(self) -> dict[str, Law]:
+        return {"noise.scale": self.scale, "noise.vio_latency_scale": self.vio_latency_scale}
+
+
+class DrawnChange(_Frozen):
+    """A knob of a scenario's ``[[changes]]`` (:data:`ridempc.sim.knobs.KNOBS`) set to a
+    drawn ``value`` or ``scale``; ``body`` may list several bodies, each set to the same
+    draw (both shoes of a pair). A payload is the ``[payload]`` table's.
+
+    Attributes:
+        t: When it takes effect [s] (0: before the first physics step).
+        parameter: The knob.
+        value: Its value [the knob's unit], or None.
+        scale: Its value over the nominal one [-], or None.
+        body: Where ``board_mass`` applies (one body or several).
+        gain: Which firmware gain ``firmware_gain`` sets.
+        joint: The joint ``joint_damping`` sets.
+    """
+
+    t: EventTime = Law(fixed=0.0)
+    parameter: str
+    value: Quantity | None = None
+    scale: Quantity | None = None
+    body: str | tuple[str, ...] | None = None
+    gain: str | None = None
+    joint: str | None = None
+
+    @field_validator("parameter")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if name == "payload":
+            raise ValueError("a payload is drawn in the [payload] table")
+        if name not in KNOBS:
+            valid = ", ".join(sorted(k for k in KNOBS if k != "payload"))
+            raise ValueError(f"unknown knob '{name}' (valid: {valid})")
+        return name
+
+    @model_validator(mode="after")
+    def _knob_admits_both_ends(self) -> DrawnChange:
+        """The knob's own rules (:class:`ParameterChange`) at the lowest and highest draw."""
+        where = {"gain": self.gain, "joint": self.joint, "body": (*self.bodies, None)[0]}
+        forms = {f: getattr(self, f) for f in ("value", "scale") if getattr(self, f) is not None}
+        ends = [{f: law.bounds()[0] for f, law in forms.items()}]  # (none or both: refused)
+        if len(forms) == 1:
+            ends = [{f: end} for f, law in forms.items() for end in law.bounds()]
+        for end in ends:
+            try:
+                ParameterChange.model_validate({"parameter": self.parameter, **where, **end})
+            except ValidationError as exc:  # one line: the knob's own words
+                raise ValueError(exc.errors()[0]["msg"].removeprefix("Value error, ")) from None
+        return self
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        if self.body is None:
+            return ()
+        return (self.body,) if isinstance(self.body, str) else self.body
+
+    @property
+    def label(self) -> str:
+        """Its dotted name without the form: ``changes.board_mass.left_shoe+right_shoe``."""
+        where = "+".join(self.bodies) or self.gain or self.joint
+        return f"changes.{self.parameter}" + (f".{where}" if where else "")
+
+    def quantities(self) -> dict[str, Law]:
+        laws = {f"{self.label}.{f}": getattr(self, f) for f in ("value", "scale")}
+        laws = {name: law for name, law in laws.items() if law is not None}
+        return {**laws, f"{self.label}.t": self.t}
+
+
+class Distribution(_Frozen):
+    """A checked, immutable distribution of scenario variants (module docstring).
+
+    Attributes:
+        name: Its name.
+        description: One line: what it stands for.
+        board: The board it is for, or None for any.
+        pushes: Pushes on the rider's base.
+        kicks: Kicks on board bodies.
+        payload: A payload on the rider, or None.
+        start: Start offsets, or None.
+        noise: Sensor noise and VIO latency scales, or None.
+        changes: Drawn knobs.
+    """
+
+    name: str = Field(pattern=r"^[a-z0-9][a-z0-9._-]*$")
+    description: str = ""
+    board: str | None = None
+    pushes: tuple[Push, ...] = ()
+    kicks: tuple[Kick, ...] = ()
+    payload: Payload | None = None
+    start: StartOffsets | None = None
+    noise: NoiseScales | None = None
+    changes: tuple[DrawnChange, ...] = ()
+
+    @model_validator(mode="after")
+    def _one_draw_per_knob(self) -> Distribution:
+        labels = [c.label for c in self.changes]
+        twice = sorted({label for label in labels if labels.count(label) > 1})
+        if twice:
+            raise ValueError(f"{twice[0]} is drawn twice; allowed: one entry per knob and place")
+        return self
+
+    def quantities(self, platforms: int = 0) -> dict[str, Law]:
+        """Every quantity by its dotted name, in drawing order.
+
+        Args:
+            platforms: The board's independent platforms (``start.platform_offsets`` are
+                drawn for each).
+        """
+        laws: dict[str, Law] = {}
+        for kind, events in (("push", self.pushes), ("kick", self.kicks)):
+            for i, event in enumerate(events):
+                laws |= event.quantities(kind if len(events) == 1 else f"{kind}.{i}")
+        if self.payload is not None:
+            laws |= self.payload.quantities()
+        if self.start is not None:
+            laws |= self.start.quantities(platforms)
+        if self.noise is not None:
+            laws |= self.noise.quantities()
+        for change in self.changes:
+            laws |= change.quantities()
+        return laws
+
+
+def distribution_names(board: str | None = None) -> tuple[str, ...]:
+    """The shipped distributions for ``board`` (its own and those for any board), or every
+    name when ``board`` is None."""
+    patterns = ["**/*.toml"] if board is None else ["*.toml", f"{board}/*.toml"]
+    return tuple(sorted({p.stem for pattern in patterns for p in DISTRIBUTIONS_DIR.glob(pattern)}))
+
+
+def distribution_boards(name: str) -> tuple[str, ...]:
+    """The boards the shipped distribution ``name`` is for (every board for one in the
+    folder's top level)."""
+    from ridempc.boards import board_names
+
+    boards = [b for b in board_names() if b != "none"]
+    if (DISTRIBUTIONS_DIR / f"{name}.toml").exists():
+        return tuple(boards)
+    return tuple(b for b in boards if (DISTRIBUTIONS_DIR / b / f"{name}.toml").exists())
+
+
+def distribution_files() -> tuple[Path, ...]:
+    """Every shipped distribution file."""
+    return tuple(sorted(DISTRIBUTIONS_DIR.glob("**/*.toml")))
+
+
+def load_distribution(name_or_path: str, board: str) -> Distribution:
+    """A distribution for ``board``: a shipped name (the board's own where there is one) or
+    a ``.toml`` path.
+
+    Raises:
+        UnknownNameError: Not a shipped name for ``board`` and not a ``.toml`` path.
+        ConfigError: A file that is missing, unreadable or malformed, one for another board,
+            or start offsets of platforms the board does not have (one line, naming the
+            file, the field, the value and what is allowed).
+    """
+    from ridempc.boards import load_board
+
+    loaded = load_board(board)  # UnknownNameError for an unknown board
+    if name_or_path.lower().endswith(".toml") or "/" in name_or_path:
+        path = Path(name_or_path)
+    else:
+        if name_or_path not in distribution_names(board):
+            raise UnknownNameError("distribution", name_or_path, distribution_names(board))
+        path = DISTRIBUTIONS_DIR / board / f"{name_or_path}.toml"
+        if not path.exists():
+            path = DISTRIBUTIONS_DIR / f"{name_or_path}.toml"
+    distribution = load_checked(path, Distribution, "distribution file")
+    if distribution.board is not None and distribution.board != board:
+        raise ConfigError(
+            f"{path}: field 'board': is '{distribution.board}'; allowed: '{board}' (the ride's "
+            "board), or no board for a distribution that fits any"
+        )
+    start = distribution.start
+    platforms = len(loaded.params.platform_sites) if loaded is not None else 0
+    if start is not None and start.platform_offsets is not None and platforms < 2:
+        raise ConfigError(
+            f"{path}: field 'start.platform_offsets': board '{board}' has no independent "
+            "platforms; allowed: none (only the Hovershoes' platforms move apart)"
+        )
+    return distribution
