@@ -133,6 +133,10 @@ def _rounded(x: float) -> float:
 def find_margin(ride: Callable[[float], Outcome], search: Search) -> Margin:
     """Bracket, bisect and check the largest survivable push (module docstring).
 
+    Assumes monotonicity: a rider that survives a push survives every smaller one, so that
+    one boundary separates the survived pushes from the fallen ones and bisection finds it;
+    the check rides report where that fails rather than prove that it holds.
+
     Args:
         ride: Rides one push of the given magnitude [N/kg] and says how it ended.
         search: Tolerance, first push, cap and check rides.

@@ -9,6 +9,7 @@ nothing is written for it; the command writes the results (:mod:`ridempc.sweep.m
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -78,11 +79,13 @@ class MarginResult:
         spec: What was measured.
         unpushed: The ride without a push.
         margins: Each direction's search, by direction [deg], counter-clockwise from 0.
+        wall_time_s: Wall-clock time of all the rides [s].
     """
 
     spec: MarginSpec
     unpushed: Outcome
     margins: dict[float, Margin]
+    wall_time_s: float = 0.0
 
     @property
     def failed(self) -> int:
@@ -154,6 +157,7 @@ def run_margin(spec: MarginSpec, workers: int, ride: RidePush | None = None) -> 
         Interrupted: SIGINT or SIGTERM; the workers are ended at once.
     """
     ride = ride or ride_pushed
+    started = time.monotonic()
     angles = directions(spec.directions)
     executor: Any = (
         _Inline()
@@ -171,7 +175,8 @@ def run_margin(spec: MarginSpec, workers: int, ride: RidePush | None = None) -> 
             for future in done:
                 future.result()  # an error raises now, not after the other directions
         margins = {searches[f]: f.result() for f in searches}
-        return MarginResult(spec, unpushed.result(), dict(sorted(margins.items())))
+        wall_time = time.monotonic() - started
+        return MarginResult(spec, unpushed.result(), dict(sorted(margins.items())), wall_time)
     except BrokenProcessPool as exc:
         raise RidempcError(f"a worker process died ({exc}); no margin.json was written") from None
     except BaseException:  # an interrupt: the rides under way are not waited for

@@ -155,6 +155,8 @@ def margin_payload(result: MarginResult) -> dict[str, Any]:
         "boundaries": {keys[d]: m.boundary for d, m in result.margins.items()},
         "lowest_falls": {keys[d]: m.lowest_fall for d, m in result.margins.items()},
         "failed_rides": result.failed,
+        "rides_total": 1 + sum(len(m.trials) for m in result.margins.values()),
+        "wall_time_s": round(result.wall_time_s, 1),
         "unpushed": {**_outcome(result.unpushed), "scenario_file": ride_file(0.0, 0.0)},
         "rides": {
             keys[d]: [
