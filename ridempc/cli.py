@@ -25,6 +25,7 @@ from ridempc.interrupts import handled
 from ridempc.options import EXIT_BAD_INPUT
 from ridempc.paths import motion_library_dir
 from ridempc.sweep import cli as sweep_cli
+from ridempc.sweep import margin_cli
 from ridempc.units import MAX_DURATION
 
 __all__ = ["main"]
@@ -156,6 +157,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     show.add_argument("--plot", type=options.path, default=None, help="write a PNG of the entry")
     sweep_cli.add_parser(commands)
+    margin_cli.add_parser(commands)
     return parser
 
 
@@ -309,6 +311,8 @@ def _unwritten(args: argparse.Namespace) -> str:
     if args.command == "library" and args.library_command == "build":
         folder = args.out or motion_library_dir() / f"{args.robot}-{args.board}"
         return f"the entries under way were not stored in {folder} (the stored ones are complete)"
+    if args.command == "margin":
+        return margin_cli.unwritten(args)
     if args.command == "library" and args.plot is not None:
         return f"no plot was written to {args.plot}"
     return "nothing was written"
@@ -327,6 +331,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         return _bench(args)
     if args.command == "sweep":
         return sweep_cli.run(args)
+    if args.command == "margin":
+        return margin_cli.run(args)
     return _sim(args)
 
 

@@ -23,6 +23,7 @@ __all__ = [
     "MAX_SEEDS",
     "MAX_SNAPSHOTS",
     "OneLineParser",
+    "bounded_float",
     "bounded_int",
     "duration",
     "entry_key",
@@ -101,6 +102,20 @@ def bounded_int(lower: int, upper: int) -> Callable[[str], int]:
         return value
 
     parse.__name__ = "whole number"
+    return parse
+
+
+def bounded_float(lower: float, upper: float, unit: str) -> Callable[[str], float]:
+    """An argparse type: a finite number of ``unit`` in ``[lower, upper]``."""
+    allowed = f"allowed: {unit} in [{lower:g}, {upper:g}]"
+
+    def parse(text: str) -> float:
+        value = _number(text, allowed)
+        if not lower <= value <= upper:
+            raise argparse.ArgumentTypeError(f"{text} is out of range; {allowed}")
+        return value
+
+    parse.__name__ = unit
     return parse
 
 
