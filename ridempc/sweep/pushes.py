@@ -8,12 +8,11 @@ The push is a force per kg of the rider's mass [N/kg] on its base for
 
 from __future__ import annotations
 
-import math
-
 from pydantic import ValidationError
 
 from ridempc.errors import ConfigError
 from ridempc.scenarios.scenario import Disturbance, Scenario
+from ridempc.sweep.variants import horizontal_force
 
 __all__ = [
     "DURATION_AFTER_S",
@@ -75,10 +74,7 @@ def pushed_scenario(
     fields = base.model_dump()
     fields["duration"] = push_time + duration_after
     if magnitude > 0.0:
-        angle = math.radians(degrees)
-        force = [
-            round(magnitude * f, _FORCE_DIGITS) + 0.0 for f in (math.cos(angle), math.sin(angle))
-        ]
+        force = [round(f, _FORCE_DIGITS) + 0.0 for f in horizontal_force(magnitude, degrees)]
         push = Disturbance(
             t=push_time,
             body="base",

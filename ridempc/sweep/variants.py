@@ -157,7 +157,9 @@ def _check_times(scenario: Scenario, distribution: Distribution) -> None:
             )
 
 
-def _horizontal(magnitude: float, direction_deg: float) -> tuple[float, float, float]:
+def horizontal_force(magnitude: float, direction_deg: float) -> tuple[float, float, float]:
+    """A force of ``magnitude`` in the horizontal plane, ``direction_deg`` [deg]
+    counter-clockwise from the +x (forward) axis: (x, y, 0)."""
     angle = math.radians(direction_deg)
     return (magnitude * math.cos(angle), magnitude * math.sin(angle), 0.0)
 
@@ -181,7 +183,7 @@ def _variant_fields(
                 {
                     "t": values[f"{prefix}.t"],
                     "body": "base" if kick is None else f"board/{kick.body}",
-                    "force": _horizontal(magnitude, values[f"{prefix}.direction"]),
+                    "force": horizontal_force(magnitude, values[f"{prefix}.direction"]),
                     "duration": values[f"{prefix}.duration"],
                     "per_kg": kick is None,  # a push per kg of the rider, a kick in N
                 }
