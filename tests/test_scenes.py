@@ -89,3 +89,14 @@ def test_a_push_off_may_put_a_foot_down_but_not_every_foot() -> None:
     mujoco.mj_forward(model, data)
     assert "stepped off" in (FallDetector(scene, feet_on_ground=True).check(model, data) or "")
     assert "touched the ground" in (FallDetector(scene).check(model, data) or "")
+
+
+def test_segway_start_has_the_load_over_the_axle() -> None:
+    """A self-balancing board at rest holds still only with the rider and board's centre of
+    mass over its wheels' axle; the Segway stance keyframe is leaned so that the start has it."""
+    scene = build_scene(load_robot("cassie"), DEFAULT_PHYSICS_HZ, board=load_board("segway"))
+    model, data = scene.model, scene.data
+    bodies = sorted(scene.rider_bodies | scene.board_bodies)
+    com_x = model.body_mass[bodies] @ data.xipos[bodies, 0] / model.body_mass[bodies].sum()
+    axle_x = np.mean([data.xpos[b, 0] for b in scene.board_ground_bodies])
+    assert abs(com_x - axle_x) < 0.002
