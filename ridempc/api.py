@@ -97,7 +97,9 @@ def ride(
     Raises:
         UnknownNameError: A robot, board, controller or scenario name that does not exist.
         ConfigError: Any other bad input (named with its value and what is allowed).
-        Interrupted: SIGINT or SIGTERM during the ride. Called from a script's main thread
+        Interrupted: SIGINT or SIGTERM during the ride. In an interactive session (Python's
+            prompt, a Jupyter kernel) it is raised and the session goes on, ready for the
+            next ride; the solvers' signal handlers are undone. Called from a script's main thread
             with Python's own SIGINT handler in place, the ride takes the signals as
             ``ridempc sim`` does (:func:`ridempc.interrupts.handled`): the script's
             ``finally`` blocks run, and the process ends with the command's one line and
@@ -127,6 +129,7 @@ def ride(
         seed=int(seed),
         plots=plots and out is not None,
         ground_truth=bool(ground_truth),
+        option_style="{}",
     )
     where = f"no summary.json was written in {out}" if out is not None else "no summary returned"
     with _signals_taken(where):
@@ -167,6 +170,10 @@ def _signals_taken(unwritten: str) -> Iterator[None]:
     if not ours:
         yield
         return
+    if _interactive():
+        with handled(unwritten, keeps_process=True):
+            yield
+        return
     with handled(unwritten) as handling:
         try:
             yield
@@ -177,6 +184,12 @@ def _signals_taken(unwritten: str) -> Iterator[None]:
                 ending.daemon = True
                 ending.start()
             raise
+
+
+def _interactive() -> bool:
+    """Whether the process is an interactive session, which must outlive an interrupt:
+    Python's prompt (``sys.ps1``, ``python -i``) or a Jupyter/IPython kernel."""
+    return hasattr(sys, "ps1") or bool(sys.flags.interactive) or "ipykernel" in sys.modules
 
 
 def _ends_quietly(handling: Handling, previous: Callable[..., Any]) -> Callable[..., Any]:

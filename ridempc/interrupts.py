@@ -142,15 +142,17 @@ class Handling:
         reported: Whether the one line has been written.
     """
 
-    def __init__(self, unwritten: str) -> None:
+    def __init__(self, unwritten: str, keeps_process: bool = False) -> None:
         self.unwritten = unwritten
+        self.keeps_process = keeps_process
         self.received: int | None = None
         self.reported = False
         self._action = _disposition(signal.SIGINT)  # Python's own C handler, installed by now
 
     def on_signal(self, signum: int, frame: FrameType | None) -> None:
-        """The first signal raises :class:`Interrupted`; any further one ends the process."""
-        if self.received is not None:
+        """The first signal raises :class:`Interrupted`; any further one ends the process
+        (raises again where the process is kept: an interactive session)."""
+        if self.received is not None and not self.keeps_process:
             self.exit_now(signum, frame)
         self.received = signum
         raise Interrupted(signum)
@@ -224,18 +226,29 @@ class _Watcher:
         first = signal.sigwait(SIGNALS)
         if self._closing:
             return
-        _thread.interrupt_main(signal.Signals(first))
-        signal.pthread_kill(threading.main_thread().ident or 0, _WAKE)  # out of a wait
+        self._interrupt_main(first)
+        while self._handling.keeps_process:  # an interactive session outlives the ride:
+            again = signal.sigwait(SIGNALS)  # each signal is one more interrupt, none ends it
+            if self._closing:
+                return
+            self._interrupt_main(again)
         if hasattr(signal, "sigtimedwait"):
             signal.sigtimedwait(SIGNALS, DEADLINE_S)  # a second one: at once
         else:
             time.sleep(DEADLINE_S)
         self._handling.exit_now(first, None)
 
+    @staticmethod
+    def _interrupt_main(signum: int) -> None:
+        _thread.interrupt_main(signal.Signals(signum))
+        signal.pthread_kill(threading.main_thread().ident or 0, _WAKE)  # out of a wait
+
     def close(self) -> None:
-        """Stop watching and unblock the signals, unless one was received: then the
-        process is ending, at ``DEADLINE_S`` at the latest, and later ones end it at once."""
-        if self._handling.received is not None or not self._thread.is_alive():
+        """Stop watching and unblock the signals, unless one was received and the process
+        is ending: then it ends at ``DEADLINE_S`` at the latest, and later signals end it at
+        once."""
+        ending = self._handling.received is not None and not self._handling.keeps_process
+        if ending or not self._thread.is_alive():
             return
         self._closing = True
         signal.pthread_kill(self._thread.ident or 0, signal.SIGINT)  # (only it can take it)
@@ -244,7 +257,9 @@ class _Watcher:
 
 
 @contextmanager
-def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
+def handled(
+    unwritten: str, process_ends: bool = False, keeps_process: bool = False
+) -> Iterator[Handling]:
     """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread while a command runs.
 
     The signals are blocked and taken by :class:`_Watcher`: a second one ends the process
@@ -261,6 +276,10 @@ def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
             signals are then ignored on leaving, also after a command that was not
             interrupted, rather than given back to Python, whose ``KeyboardInterrupt``
             would interrupt the interpreter's shutdown with a traceback.
+        keeps_process: The process outlives an interrupt (an interactive session: Python's
+            prompt, a Jupyter kernel): every signal raises :class:`Interrupted` in the main
+            thread, none ends the process, and the previous handlers are put back on
+            leaving, also after an interrupt (the solvers' threads have returned by then).
 
     Raises:
         RuntimeError: Not called from the main thread.
@@ -272,7 +291,7 @@ def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
     for s in SIGNALS:
         signal.signal(s, _dispatch)
     signal.signal(_WAKE, _woken)
-    handling = Handling(unwritten)
+    handling = Handling(unwritten, keeps_process)
     watcher = _Watcher(handling)
     streams = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = _Muted(sys.stdout, handling), _Muted(sys.stderr, handling)
@@ -284,11 +303,13 @@ def handled(unwritten: str, process_ends: bool = False) -> Iterator[Handling]:
             if isinstance(muted, _Muted):
                 with suppress(OSError, ValueError):  # a closed stream: nothing to say there
                     muted.flush()
-        if handling.received is None:  # (else the solvers may still have words to say)
+        ending = handling.received is not None and not keeps_process
+        if not ending:  # (else the solvers may still have words to say)
             sys.stdout, sys.stderr = streams
             _active = outer
+            handling.restore()  # Python's C-level SIGINT handler, whatever a solver left
         for s, handler in previous.items():  # after an interrupt the process is ending,
-            if s != _WAKE and (handling.received is not None or process_ends):  # by DEADLINE_S
+            if s != _WAKE and (ending or process_ends):  # by DEADLINE_S
                 handler = signal.SIG_IGN
             signal.signal(s, handler)
         watcher.close()  # (unblocks the signals: the handlers are in place by now)

@@ -59,6 +59,8 @@ class RideRequest:
         viewer: Show the interactive viewer (needs a display).
         ground_truth: Give the controller ground truth (debugging only; flagged in the summary).
         physics_hz: Physics rate [Hz].
+        option_style: How messages name an option: ``--{}`` on the command line, ``{}``
+            (the keyword argument) in the Python API.
     """
 
     robot: str
@@ -73,6 +75,7 @@ class RideRequest:
     plots: bool = True
     viewer: bool = False
     ground_truth: bool = False
+    option_style: str = "--{}"
     physics_hz: int = DEFAULT_PHYSICS_HZ
 
 
@@ -121,13 +124,13 @@ def check_request(request: RideRequest) -> CheckedRide:
     """
     out = None
     if request.out is not None:
-        out = writable_dir(Path(request.out), "--out folder")
+        out = writable_dir(Path(request.out), request.option_style.format("out") + " folder")
         check_clearable(out)
     elif request.video or request.snapshots > 0 or request.viewer:
         raise ConfigError("a video, snapshots or the viewer need an output folder (out)")
     if request.duration is not None and not MIN_DURATION <= request.duration <= MAX_DURATION:
         raise ConfigError(  # NaN fails the comparison too
-            f"--duration {request.duration}: allowed: seconds in "
+            f"{request.option_style.format('duration')} {request.duration}: allowed: seconds in "
             f"[{MIN_DURATION:g}, {MAX_DURATION:g}]"
         )
     if request.video:
