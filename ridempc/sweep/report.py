@@ -35,6 +35,7 @@ __all__ = [
 
 MAX_BINS: int = 5  # bins per drawn quantity: 20 variants a bin at 100 samples
 WORST_RIDES: int = 5  # worst rides listed per controller
+EXTREME_DRAWS: int = 3  # draws named per worst ride: a table row one line wide
 
 
 @dataclass
@@ -260,8 +261,34 @@ def _badness(summary: Mapping[str, Any]) -> tuple[int, float, float]:
     )
 
 
+def _extreme_draws(variants: Sequence[Mapping[str, Any]]) -> dict[str, list[str]]:
+    """Per variant, its ``EXTREME_DRAWS`` draws furthest into the tails of what the sweep
+    drew (by rank among the variants), e.g. ``payload.fraction 0.29 (top 3 %)``: a hard
+    distribution draws twenty quantities, and the ones at the edge of their range are the
+    likely causes of a fall."""
+    ranks: dict[str, dict[str, float]] = {v["id"]: {} for v in variants}
+    for name in sorted({k for v in variants for k in v["drawn"]}):
+        drawn = [v for v in variants if name in v["drawn"]]
+        values = np.array([float(v["drawn"][name]) for v in drawn])
+        if len(values) < 2 or np.ptp(values) == 0.0:
+            continue
+        order = (np.argsort(np.argsort(values)) + 0.5) / len(values)  # mid-rank in (0, 1)
+        for v, rank in zip(drawn, order, strict=True):
+            ranks[v["id"]][name] = float(rank)
+    out = {}
+    for v in variants:
+        tails = sorted(ranks[v["id"]].items(), key=lambda kv: -abs(kv[1] - 0.5))
+        out[v["id"]] = [
+            f"{k} {float(v['drawn'][k]):.4g} "
+            f"({'top' if r > 0.5 else 'bottom'} {100 * min(r, 1 - r):.0f} %)"
+            for k, r in tails[:EXTREME_DRAWS]
+        ]
+    return out
+
+
 def _worst_section(results: Mapping[str, Any], folder: Path) -> _Section:
-    rows = [["controller", "variant", "seed", "outcome", "drawn"]]
+    rows = [["controller", "variant", "seed", "outcome", "draws furthest in the tails"]]
+    extremes = _extreme_draws(results["variants"])
     commands = []
     for c in results["controllers"]:
         ranked = sorted(results["variants"], key=lambda v: _badness(v["summaries"][c]))
@@ -274,11 +301,14 @@ def _worst_section(results: Mapping[str, Any], folder: Path) -> _Section:
             else:
                 rmse = s.get("velocity_rmse")
                 outcome = "rode" + ("" if rmse is None else f", velocity RMSE {rmse:.3g} m/s")
-            drawn = ", ".join(f"{k} {x:.4g}" for k, x in sorted(v["drawn"].items()))
+            drawn = ", ".join(extremes[v["id"]])
             rows.append([c, v["id"], str(v["seed"]), outcome, drawn or "-"])
             commands.append(f"# {c} {v['id']}: {outcome}")
             commands.append(replay_command(results, v, c, folder))
-    text = "Each ride again, with its log and plots: the commands below."
+    text = (
+        "Each ride again, with its log and plots: the commands below; every drawn value "
+        "of a variant is in its `variants/<id>.toml`."
+    )
     return _Section("Worst rides", text, rows=rows, commands=commands)
 
 
