@@ -51,3 +51,17 @@ def test_sweep_results_counts() -> None:
     assert pd["metrics"]["velocity_rmse"]["median"] == pytest.approx(0.055)
     assert pd["metrics"]["fall_time_s"]["rides"] == 3 and pd["worker_peak_rss_mib"] == 300.0
     assert results["failed"] == 0 and len(results["variants"]) == 10
+
+
+def test_worst_rides_name_the_draws_furthest_in_the_tails() -> None:
+    from ridempc.sweep.report import EXTREME_DRAWS, _extreme_draws
+
+    variants = [
+        {"id": f"v{i}", "drawn": {"a": float(i), "b": float(-i), "c": 1.0, "d": float(i % 5),
+                                  "e": float(i * i % 7)}}
+        for i in range(10)
+    ]  # fmt: skip
+    named = _extreme_draws(variants)
+    assert all(len(names) == EXTREME_DRAWS for names in named.values())
+    assert set(named["v9"][:2]) == {"a 9 (top 5 %)", "b -9 (bottom 5 %)"}  # the extremes
+    assert not any(name.startswith("c ") for names in named.values() for name in names)
