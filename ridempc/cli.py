@@ -119,8 +119,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     bench.add_argument(
         "--wbc-solver",
-        default="osqp",
-        help="the whole-body QP's solver in the ride and its timing: osqp (default) or daqp",
+        default=None,
+        help="the whole-body QP's solver in the ride and its timing: daqp (default) or osqp",
     )
     bench.add_argument(
         "--profile",
