@@ -45,6 +45,7 @@ would still be approximate.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import NamedTuple
@@ -53,6 +54,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.mpc.codegen import compiled
 from ridempc.mpc.discretisation import zero_order_hold
 from ridempc.trajopt.schedule import Contact
 
@@ -111,14 +113,16 @@ class LinearModel:
 
     def evaluate(self, x0: Array, u_ref: Array, p_k: Array) -> tuple[Array, Array, Array]:
         """:attr:`jacobians` at :math:`(\\hat x_0, \\bar u_k, p_k)` for every step, in one
-        call of a mapped function built once per horizon.
+        call of a mapped function built once per horizon (compiled to C and cached,
+        :func:`~ridempc.mpc.codegen.compiled`).
 
         Returns:
             :math:`f_k` (N x nx), :math:`A^c_k` (N x nx x nx), :math:`B^c_k` (N x nx x nu).
         """
         horizon = len(u_ref)
         if horizon not in self._mapped:
-            self._mapped[horizon] = _MappedJacobians(self.jacobians.map(horizon), horizon)
+            mapped = compiled(self.jacobians.map(horizon))  # C where a compiler is found
+            self._mapped[horizon] = _MappedJacobians(mapped, horizon)
         return self._mapped[horizon](x0, u_ref, p_k)
 
 
@@ -353,18 +357,19 @@ class MpcProblem:
         }
         bounds = ("input_lower", "input_upper", "constraint_lower", "constraint_upper")
         for name, value in checked.items():
-            if name not in bounds and not np.all(np.isfinite(value)):
+            # a sum is NaN or infinite when an entry is: one reduction, not an array of flags
+            if name not in bounds and not math.isfinite(value.sum()):
                 raise ValueError(f"MpcProblem: {name} holds NaN or infinite values")
-            if name in bounds and np.any(np.isnan(value)):
+            if name in bounds and np.isnan(value).any():
                 raise ValueError(f"MpcProblem: {name} holds NaN")
             object.__setattr__(self, name, value)
         for name in ("state_weights", "input_weights", "terminal_weights"):
-            if np.any(checked[name] < 0.0):
+            if checked[name].min() < 0.0:
                 raise ValueError(f"MpcProblem: {name} must be non-negative")
         for low, high in (("input_lower", "input_upper"), ("constraint_lower", "constraint_upper")):
-            bad = np.argwhere(checked[low] > checked[high])
-            if len(bad):
-                k, i = bad[0]
+            above = checked[low] > checked[high]
+            if above.any():
+                k, i = np.argwhere(above)[0]
                 raise ValueError(
                     f"MpcProblem: {low}[{k}, {i}] = {checked[low][k, i]:g} is above "
                     f"{high}[{k}, {i}] = {checked[high][k, i]:g}"
