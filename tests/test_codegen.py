@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from ridempc.mpc import codegen
+from ridempc.mpc.buffered import BufferedFunction
 from ridempc.mpc.codegen import COMPILER_ENV, compiled, library_path
 
 needs_gcc = pytest.mark.skipif(codegen._compiler() is None, reason="no C compiler here")
@@ -90,3 +91,16 @@ def test_a_failed_build_takes_the_python_path_with_one_warning(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "building map4_toy_jacobians" in err and "failed" in err
     assert not list(tmp_path.glob("*.so"))
+
+
+def test_a_buffered_function_gives_casadis_dense_outputs() -> None:
+    function = _model(9.81)
+    buffered = BufferedFunction(function)
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        x, u = rng.normal(size=(3, 4)), rng.normal(size=(2, 4))
+        for mine, theirs in zip(buffered(x, u), function(x, u), strict=True):
+            assert np.array_equal(mine, np.asarray(ca.DM(theirs)))
+    sparse = ca.Function("sparse", [ca.SX.sym("s", ca.Sparsity.diag(3))], [ca.SX(1, 1)])
+    with pytest.raises(ValueError, match="input 0 of sparse is sparse"):
+        BufferedFunction(sparse)

@@ -54,6 +54,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.mpc.buffered import BufferedFunction
 from ridempc.mpc.codegen import compiled
 from ridempc.mpc.discretisation import zero_order_hold
 from ridempc.trajopt.schedule import Contact
@@ -127,20 +128,13 @@ class LinearModel:
 
 
 class _MappedJacobians:
-    """A mapped Jacobian function evaluated into NumPy buffers (CasADi's ``buffer``), its
-    sparse outputs scattered into dense stacks: converting CasADi matrices to NumPy costs
-    more than evaluating them."""
+    """A mapped Jacobian function evaluated into NumPy buffers
+    (:class:`~ridempc.mpc.buffered.BufferedFunction`), its sparse outputs scattered into
+    dense stacks: converting CasADi matrices to NumPy costs more than evaluating them."""
 
     def __init__(self, function: ca.Function, horizon: int) -> None:
         self.function, self.horizon = function, horizon
-        self.buffer, self.run = function.buffer()
-        self.args = [np.zeros(function.nnz_in(i)) for i in range(3)]
-        self.results = [np.zeros(function.nnz_out(i)) for i in range(3)]
-        # CasADi's stubs list a size argument its SWIG wrapper takes from the buffer itself.
-        for i, array in enumerate(self.args):
-            self.buffer.set_arg(i, memoryview(array))  # type: ignore[call-arg, arg-type]
-        for i, array in enumerate(self.results):
-            self.buffer.set_res(i, memoryview(array))  # type: ignore[call-arg, arg-type]
+        self.buffered = BufferedFunction(function)
         self.scatter = []
         for i in (1, 2):  # columns j + k n of step k, nonzeros in column-major order
             rows, cols = (
@@ -150,14 +144,11 @@ class _MappedJacobians:
             self.scatter.append((cols // n, rows, cols % n, n))
 
     def __call__(self, x0: Array, u_ref: Array, p_k: Array) -> tuple[Array, Array, Array]:
-        self.args[0][:] = np.tile(x0, self.horizon)
-        self.args[1][:] = u_ref.ravel()
-        self.args[2][:] = p_k.ravel()
-        self.run()
+        results = self.buffered.nonzeros(np.tile(x0, self.horizon), u_ref.ravel(), p_k.ravel())
         nx = len(x0)
-        rates = self.results[0].reshape(self.horizon, nx).copy()
+        rates = results[0].reshape(self.horizon, nx).copy()
         dense = []
-        for (k, i, j, n), values in zip(self.scatter, self.results[1:], strict=True):
+        for (k, i, j, n), values in zip(self.scatter, results[1:], strict=True):
             out = np.zeros((self.horizon, nx, n))
             out[k, i, j] = values
             dense.append(out)
