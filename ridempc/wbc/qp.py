@@ -1,4 +1,4 @@
-"""The whole-body QP: build its matrices from tasks and constraints, solve them with OSQP.
+"""The whole-body QP: build its matrices from tasks and constraints, solve them by name.
 
 .. math:: \\min_z \\tfrac12 z^\\top P z + q^\\top z \\quad \\text{s.t.} \\quad l \\le A z \\le u,
           \\qquad P = \\sum_i H_i, \\quad q = \\sum_i c_i
@@ -30,9 +30,11 @@ to DAQP (an exact dual active-set solver, Arnström et al. 2022), counted in
 dog's QP in a push-off, with eigenvalues from 1e-5 to 100, ran out of 2000 iterations
 warm and cold, and DAQP solved it to 1e-12 in 0.2 ms.
 
-**Or DAQP alone.** With ``solver="daqp"`` (:attr:`WbcSettings.solver
-<ridempc.wbc.settings.WbcSettings>`) every problem goes straight to DAQP, so that
-``ridempc bench --wbc-solver daqp`` measures the choice of OSQP in the closed loop.
+**Or DAQP alone, the registry's choice.** The solver is named in :attr:`WbcSettings.solver
+<ridempc.wbc.settings.WbcSettings>`, by default the one :data:`ridempc.solvers.QP_KINDS`
+measured fastest on the recorded problems: DAQP, to which every problem then goes straight
+(:func:`ridempc.solvers.solve_dense`); ``solver="osqp"`` takes the workspace above, so that
+``ridempc bench --wbc-solver osqp`` measures the choice in the closed loop.
 """
 
 from __future__ import annotations
