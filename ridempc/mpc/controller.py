@@ -134,6 +134,9 @@ class LinearMpc:
         )
         self.qp: MpcQP | None = None
         self._shift: tuple[bytes, StaticShift] | None = None  # the last static shift, by key
+        for horizon in (self.settings.horizon, 1):  # the problems' and the static shift's
+            model.prepare(horizon)  # compiled before the first tick, as are the surfaces:
+        surface_rotations(pair, reference.states[0])
 
     @property
     def terminal_factor(self) -> float:

@@ -120,11 +120,16 @@ class LinearModel:
         Returns:
             :math:`f_k` (N x nx), :math:`A^c_k` (N x nx x nx), :math:`B^c_k` (N x nx x nu).
         """
-        horizon = len(u_ref)
+        return self.prepare(len(u_ref))(x0, u_ref, p_k)
+
+    def prepare(self, horizon: int) -> _MappedJacobians:
+        """The mapped Jacobians of ``horizon`` steps, built (and compiled, a few seconds
+        the first time on a machine) now if not yet: a controller prepares its horizons
+        before its first tick."""
         if horizon not in self._mapped:
             mapped = compiled(self.jacobians.map(horizon))  # C where a compiler is found
             self._mapped[horizon] = _MappedJacobians(mapped, horizon)
-        return self._mapped[horizon](x0, u_ref, p_k)
+        return self._mapped[horizon]
 
 
 class _MappedJacobians:
