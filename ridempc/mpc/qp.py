@@ -151,6 +151,19 @@ class SolveOutcome(NamedTuple):
     seconds: float
 
 
+class _Update(NamedTuple):
+    """What one solve writes into OSQP: the diagonal of :math:`D P D`, the values of
+    :math:`A_{qp} D` on the pattern, the scaled bounds, and the warm start (primal and
+    dual; None: none)."""
+
+    weights: Array
+    values: Array
+    lower: Array
+    upper: Array
+    primal: Array | None
+    dual: Array | None
+
+
 class MpcQP:
     """The sparse MPC QP, built once for a horizon, sizes and :class:`QPStructure`.
 
@@ -194,6 +207,7 @@ class MpcQP:
         self.failures = 0
         self._previous: Plan | None = None
         self._previous_dual: Array | None = None
+        self._staged: _Update | None = None  # started, not yet written into OSQP
         n = self.horizon
         sx = np.ones(self.nx) if state_scale is None else np.asarray(state_scale, dtype=float)
         su = np.ones(self.nu) if input_scale is None else np.asarray(input_scale, dtype=float)
@@ -205,6 +219,15 @@ class MpcQP:
             [np.tile(sx, n + 1), np.tile(su, n), np.ones(n * self.n_constraints)]
         )
         self._input_scale = su
+        s = self.structure
+        self._outside_at = {
+            name: np.flatnonzero(~pattern)
+            for name, pattern in (
+                ("A", s.state_pattern),
+                ("B", s.input_pattern),
+                ("constraint_matrix", s.constraint_pattern),
+            )
+        }
         self._build_pattern()
         hessian, csc = self.matrices(problem)
         _, lower, upper = self._data(problem)
@@ -298,8 +321,14 @@ class MpcQP:
         )
 
     def _outside(self, name: str, values: Array, pattern: BoolArray) -> None:
+        outside = self._outside_at[name]  # flat indices of the entries off the pattern
+        if not outside.size:
+            return
+        largest = float(np.abs(values.reshape(len(values), -1).take(outside, axis=1)).max())
+        if largest <= _PATTERN_TOLERANCE:  # below the bound whatever the matrix's scale
+            return
         stray = np.abs(values[:, ~pattern])
-        if stray.size and stray.max() > _PATTERN_TOLERANCE * max(1.0, np.abs(values).max()):
+        if stray.max() > _PATTERN_TOLERANCE * max(1.0, np.abs(values).max()):
             raise ValueError(
                 f"MpcQP: {name} has a non-zero outside the QP's fixed pattern "
                 f"(largest {stray.max():.3g}); build the QP with a QPStructure covering it"
@@ -408,9 +437,23 @@ class MpcQP:
             ValueError: Sizes differ from the QP's, or a matrix has a non-zero outside
                 the QP's :class:`QPStructure` (a wrong pair, not a solver failure).
         """
+        self._write(self._values(problem))
+
+    def _values(self, problem: MpcProblem) -> _Update:
+        """What :meth:`update` writes into OSQP for ``problem`` (no warm start).
+
+        Raises:
+            ValueError: As :meth:`update`.
+        """
         self._check_sizes(problem)
         values, lower, upper = self._data(problem)
-        self._solver.update(Px=self._weights(problem), Ax=values, l=lower, u=upper)
+        return _Update(self._weights(problem), values, lower, upper, None, None)
+
+    def _write(self, update: _Update) -> None:
+        """``update`` written into OSQP: the values, then the warm start if any."""
+        self._solver.update(Px=update.weights, Ax=update.values, l=update.lower, u=update.upper)
+        if update.primal is not None:
+            self._solver.warm_start(x=update.primal, y=update.dual)
 
     def _unpack(self, z: Array) -> tuple[Array, Array]:
         n, nx = self.horizon, self.nx
@@ -432,32 +475,38 @@ class MpcQP:
         return self.finish(started, self.run())
 
     def start(self, problem: MpcProblem) -> StartedSolve:
-        """The first part of :meth:`solve`: the QP updated with ``problem`` and warm-started.
-        :meth:`run` then solves it (OSQP releases Python's lock while it iterates, so that
-        may go on in another thread) and :meth:`finish` turns the outcome into the plan.
+        """The first part of :meth:`solve`: the values of ``problem`` and the warm start
+        made ready for OSQP. :meth:`run` then writes them in and solves (OSQP releases
+        Python's lock while it refactors its KKT matrix and iterates, so that may go on in
+        another thread) and :meth:`finish` turns the outcome into the plan.
 
         Raises:
             ValueError: As :meth:`update`.
         """
         begin = time.perf_counter()
-        self.update(problem)
+        update = self._values(problem)
         reference = self._reference(problem)
         if self._previous is not None:
             states, inputs = self._previous.states, self._previous.inputs
             z = np.concatenate([states.ravel(), inputs.ravel()])[self._primal_shift]
             y = None if self._previous_dual is None else self._previous_dual[self._dual_shift]
-            self._solver.warm_start(x=(z - reference) / self._scale, y=y)
+            update = update._replace(primal=(z - reference) / self._scale, dual=y)
+        self._staged = update
         return StartedSolve(problem, reference, time.perf_counter() - begin)
 
     def run(self) -> SolveOutcome:
-        """OSQP's solve of the started QP (:meth:`start`).
+        """The started QP (:meth:`start`) written into OSQP (its KKT matrix refactored)
+        and solved.
 
         Raises:
             Interrupted: In the main thread, when the command was interrupted
                 (:func:`~ridempc.interrupts.osqp_returned`); nothing else.
         """
         begin = time.perf_counter()
+        staged, self._staged = self._staged, None
         try:
+            if staged is not None:
+                self._write(staged)
             result = self._solver.solve(raise_error=False)
             status, iterations = str(result.info.status), int(result.info.iter)
             ok = result.info.status_val == _SOLVED
