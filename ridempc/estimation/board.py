@@ -39,8 +39,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.estimation.lapack import svd
-from ridempc.estimation.rotations import rpy_of_matrix
 from ridempc.estimation.state import BoardEstimate
+from ridempc.rotations import rpy_of_matrix
 
 __all__ = ["estimate_board"]
 

@@ -50,6 +50,7 @@ from ridempc.boards.identification import (
     r_squared,
 )
 from ridempc.robots import load_robot
+from ridempc.rotations import quaternion_to_matrix
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
@@ -186,7 +187,7 @@ def run_trials(
     trials = []
     for i, shoe in enumerate(inputs):
         quat = log["board_quaternion"][:, i]
-        rotation = np.array([_matrix(q) for q in quat])
+        rotation = np.array([quaternion_to_matrix(q) for q in quat])
         omega = log["board_angular_velocity"][:, i]
         velocity = log["board_velocity"][:, i]
         heading = rotation[:, :, 0].copy()
@@ -212,12 +213,6 @@ def run_trials(
             )
         )
     return trials[0], trials[1]
-
-
-def _matrix(quat: Array) -> Array:
-    out = np.empty(9)
-    mujoco.mju_quat2Mat(out, quat)
-    return out.reshape(3, 3)
 
 
 def _response(num: list[float], den: list[float], u: Array, dt: float) -> Array:

@@ -33,14 +33,9 @@ from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.boards.parameters import BoardParameters
 from ridempc.boards.segway.parameters import SegwayParameters
 from ridempc.errors import ConfigError
+from ridempc.rotations import pitch_of
 
 __all__ = ["SegwayFirmware"]
-
-
-def platform_pitch(quat_wxyz: np.ndarray) -> float:
-    """Pitch of the platform about its lateral axis, positive nose down [rad]."""
-    w, x, y, z = quat_wxyz
-    return float(np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0)))
 
 
 class SegwayFirmware(Firmware):
@@ -61,7 +56,7 @@ class SegwayFirmware(Firmware):
 
     def update(self) -> None:
         p, g, io = self.segway, self.segway.gains, self.io
-        pitch = platform_pitch(io.sensor("platform_quat"))
+        pitch = pitch_of(io.sensor("platform_quat"))  # positive nose down
         gyro = io.sensor("platform_gyro")
         wheel_rate = 0.5 * float(io.sensor("left_wheel_vel")[0] + io.sensor("right_wheel_vel")[0])
         speed = p.wheel_radius * (wheel_rate + float(gyro[1]))
