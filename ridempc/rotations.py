@@ -3,9 +3,9 @@
 The package's one set of numeric rotation helpers, each a call to Pinocchio's or MuJoCo's
 compiled built-in where one exists, else a few operations on Python floats (NumPy's
 scalar calls cost more than the arithmetic): 2.6-7.5x faster than the NumPy formulas they
-replace, on single rotations (0.2-1.1 us a call). Each agrees with the formula it replaced to a few units in the last
-place (``tests/test_rotations.py``); CasADi's symbolic twins stay in
-:mod:`ridempc.trajopt.rotations`.
+replace, on single rotations (0.2-1.1 us a call). Each agrees with the formula it replaced
+to a few units in the last place (``tests/test_rotations.py``); CasADi's symbolic twins
+stay in :mod:`ridempc.trajopt.rotations`.
 
 Conventions: a quaternion or matrix maps a vector from a body frame to the world,
 :math:`v_W = R_{WB} v_B`; quaternions are (w, x, y, z), as MuJoCo stores them; Euler

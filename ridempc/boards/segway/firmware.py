@@ -27,8 +27,6 @@ above the top speed (the tilt-back of real transporters).
 
 from __future__ import annotations
 
-import numpy as np
-
 from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.boards.parameters import BoardParameters
 from ridempc.boards.segway.parameters import SegwayParameters
@@ -60,7 +58,8 @@ class SegwayFirmware(Firmware):
         gyro = io.sensor("platform_gyro")
         wheel_rate = 0.5 * float(io.sensor("left_wheel_vel")[0] + io.sensor("right_wheel_vel")[0])
         speed = p.wheel_radius * (wheel_rate + float(gyro[1]))
-        excess = max(abs(speed) - p.top_speed, 0.0) * np.sign(speed)
+        # in Python floats (np.sign and np.clip on a scalar cost 1 and 5 us): the same numbers
+        excess = max(abs(speed) - p.top_speed, 0.0) * ((speed > 0.0) - (speed < 0.0))
         total = (
             g.pitch_kp * pitch
             + g.pitch_kd * float(gyro[1])
@@ -68,7 +67,7 @@ class SegwayFirmware(Firmware):
             + g.pushback_gain * excess
         )
         knee = float(io.sensor("knee_bar_angle")[0])
-        yaw_rate_ref = float(np.clip(g.turn_gain * knee, -g.max_yaw_rate, g.max_yaw_rate))
+        yaw_rate_ref = min(max(g.turn_gain * knee, -g.max_yaw_rate), g.max_yaw_rate)
         yaw = g.yaw_rate_kp * (yaw_rate_ref - float(gyro[2]))
         left = io.actuate("left_wheel", 0.5 * total - yaw)
         right = io.actuate("right_wheel", 0.5 * total + yaw)
