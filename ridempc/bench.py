@@ -42,6 +42,13 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    layout, see :func:`_stage_layout`); each is timed from a cold start per problem (no
    warm start, only the solve call), and its objective compared with OSQP's.
 
+The JSON's ``controller_tick_p99_ms`` is the p99 of the rider's whole update per control
+tick (estimator, MPC share, WBC and the rest), ``mpc_tick_p99_ms`` the MPC tick's (build
+and solve), ``controller_physics_ratio`` the rider's wall time over the simulation's in the
+same ride and ``reference_ms`` the machine reference. With ``profile`` (``--profile``) the
+pair rides once more under :class:`~ridempc.tickprofile.PartProfiler`, and ``profile``
+lists each part's hottest functions by their own time.
+
 With ``wbc_solver="daqp"`` (``--wbc-solver daqp``) the whole-body QPs are solved by DAQP
 alone, in the ride (so its real-time factor and budget are DAQP's) and in step 3; step 4's
 WBC comparison, made against OSQP's warm workspace, is then left out. The product's solver
@@ -70,6 +77,7 @@ from ridempc.errors import RidempcError
 from ridempc.heap import frozen_heap
 from ridempc.interrupts import casadi_solve, osqp_returned
 from ridempc.io import atomic_write_json
+from ridempc.tickprofile import DEFAULT_TOP, PartProfiler, profile_table
 
 __all__ = ["PairBench", "bench", "bench_table"]
 
@@ -100,6 +108,8 @@ class PairBench:
     mpc_solve_p99_ms: float = float("nan")
     mpc_tick_median_ms: float = float("nan")
     mpc_tick_p99_ms: float = float("nan")
+    controller_tick_p99_ms: float = float("nan")
+    controller_physics_ratio: float = float("nan")
     wbc_solve_median_ms: float = float("nan")
     wbc_solve_p99_ms: float = float("nan")
     mpc_solve_best_p99_ms: float = float("nan")
@@ -110,6 +120,7 @@ class PairBench:
     reference_ms: float = float("nan")
     solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
     wbc_solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
+    profile: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
 
 
 REFERENCE_ADDITIONS: int = 1_000_000  # the machine reference's loop (reference_ms)
@@ -187,8 +198,15 @@ def _timed(function: Callable[..., Any], spent: dict[str, float], key: str) -> C
 
 
 def _record(
-    robot_name: str, board_name: str, scenario_name: str, seconds: float, wbc_solver: str = "osqp"
+    robot_name: str,
+    board_name: str,
+    scenario_name: str,
+    seconds: float,
+    wbc_solver: str = "osqp",
+    profiler: PartProfiler | None = None,
 ) -> tuple[Any, list, list, Any, dict[str, float]]:
+    """One ride of the pair's rider, its MPC problems and WBC inputs kept; with
+    ``profiler``, each part of its ticks (:data:`BUDGET_PARTS`) recorded into its own."""
     from ridempc.boards import load_board
     from ridempc.mpc.rider import MpcRider
     from ridempc.robots import load_robot
@@ -218,10 +236,33 @@ def _record(
     rider.estimator.update = _timed(  # type: ignore[method-assign]
         rider.estimator.update, parts, "estimator"
     )
+    if profiler is not None:
+        _profiled(rider, profiler)
     scenario = resolve_scenario(scenario_name, board_name).with_duration(seconds)
     scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=load_board(board_name))
-    result = Simulation(scene, rider, scenario).run()
+    simulation = Simulation(scene, rider, scenario)
+    if profiler is not None:
+        profiler.start()
+    try:
+        result = simulation.run()
+    finally:
+        if profiler is not None:
+            profiler.stop()
     return result, problems, wbc_inputs, rider, _budget(result, parts, rider.mpc_loop_seconds)
+
+
+def _profiled(rider: Any, profiler: PartProfiler) -> None:
+    """``rider``'s parts recorded each into its own profile (the simulation's is the
+    loop's, the rest of the rider's its update's; the MPC's its ticks and the waits for
+    their plans in the loop's thread)."""
+    for owner, method, part in (
+        (rider, "update", "rider_rest"),
+        (rider.estimator, "update", "estimator"),
+        (rider.wbc, "solve", "wbc"),
+        (rider, "_mpc_tick", "mpc"),
+        (rider, "_adopt_pending", "mpc"),
+    ):
+        setattr(owner, method, profiler.wrap(getattr(owner, method), part))
 
 
 def _as_qpsolvers(
@@ -458,9 +499,12 @@ def bench_pair(
     seconds: float = DEFAULT_SECONDS,
     scenario: str | None = None,
     wbc_solver: str = "osqp",
+    profile: bool = False,
 ) -> PairBench:
     """Record one pair's ride and time its problems (see the module docstring), with
-    ``wbc_solver`` solving the whole-body QPs in the ride and in their timing."""
+    ``wbc_solver`` solving the whole-body QPs in the ride and in their timing; with
+    ``profile``, ride again under :class:`~ridempc.tickprofile.PartProfiler` for the
+    hottest functions of each part of the tick."""
     from ridempc.mpc.controller import LinearMpc
 
     name = f"{robot}-{board}"
@@ -476,6 +520,12 @@ def bench_pair(
     out.real_time_factor = float(result.sim_time / loop) if loop > 0 else float("nan")
     out.mpc_problems, out.wbc_ticks = len(problems), len(wbc_inputs)
     out.mpc_tick_median_ms, out.mpc_tick_p99_ms = _stats([1e-3 * ms for ms in rider.mpc_tick_ms])
+    out.controller_tick_p99_ms = _stats(result.controller_times.tolist())[1]
+    out.controller_physics_ratio = _controller_physics_ratio(result)
+    if profile:
+        profiler = PartProfiler(BUDGET_PARTS)
+        profiled = _record(robot, board, out.scenario, seconds, wbc_solver, profiler)[0]
+        out.profile = profiler.hottest(len(profiled.controller_times), DEFAULT_TOP)
     if problems:
         mpc = LinearMpc(rider.pair, rider.mpc.reference, rider.mpc.model, rider.mpc.settings)
         times, qp = _mpc_pass(mpc, problems)
@@ -492,6 +542,14 @@ def bench_pair(
         # the comparison is against OSQP's warm workspace: with DAQP in the loop, none
         out.wbc_solvers = _other_wbc_solvers(solved) if wbc_solver == "osqp" else {}
     return out
+
+
+def _controller_physics_ratio(result: Any) -> float:
+    """The rider's wall time over the simulation's (physics, sensors, firmware, log) in
+    the same ride [-]."""
+    rider = float(np.sum(result.controller_times))
+    physics = result.wall_time - rider
+    return rider / physics if physics > 0.0 else float("nan")
 
 
 def _best_p99(passes: Sequence[Sequence[float]]) -> float:
@@ -590,8 +648,9 @@ def bench_table(rows: Sequence[PairBench]) -> str:
     lines = [
         "| pair | scenario | ride | MPC problems | MPC QP median / p99 / best p99 [ms] | "
         "MPC tick in the ride median / p99 [ms] | WBC ticks (failed) | "
-        "WBC (solver) median / p99 / best p99 [ms] | real-time factor |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "WBC (solver) median / p99 / best p99 [ms] | controller tick p99 [ms] | "
+        "controller / physics | real-time factor |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         mpc = (r.mpc_solve_median_ms, r.mpc_solve_p99_ms, r.mpc_solve_best_p99_ms)
@@ -602,11 +661,15 @@ def bench_table(rows: Sequence[PairBench]) -> str:
             f"{_ms(r.mpc_tick_median_ms)} / {_ms(r.mpc_tick_p99_ms)} | "
             f"{r.wbc_ticks} ({r.wbc_failures}) | "
             f"({r.wbc_solver}) {' / '.join(map(_ms, wbc))} | "
+            f"{_ms(r.controller_tick_p99_ms)} | {_ms(r.controller_physics_ratio)} | "
             f"{_ms(r.real_time_factor)} |"
         )
     lines += _budget_table(rows)
     for what, table in (("MPC", "solvers"), ("WBC", "wbc_solvers")):
         lines += _solver_table(what, [(r.pair, getattr(r, table)) for r in rows])
+    profiled = [(r.pair, r.profile) for r in rows if r.profile]
+    if profiled:
+        lines += profile_table(profiled)
     return "\n".join(lines)
 
 
@@ -648,10 +711,12 @@ def bench(
     json_path: Path | None = None,
     scenario: str | None = None,
     wbc_solver: str = "osqp",
+    profile: bool = False,
 ) -> list[PairBench]:
     """Benchmark ``pairs`` (default: every pair with an MPC) on their
     :data:`BENCH_SCENARIOS` (or ``scenario`` for all), with ``wbc_solver`` in the
-    whole-body QP, print and optionally save.
+    whole-body QP, print and optionally save; with ``profile``, each pair's hottest
+    functions per part of the tick too.
 
     Raises:
         UnknownNameError: A pair without an MPC, an unknown scenario or an unknown
@@ -679,7 +744,7 @@ def bench(
     for name in names:
         robot, board = name.split("-", 1)
         print(f"  {name}: recording {seconds:g} s of {recorded[name]} ...", flush=True)
-        rows.append(bench_pair(robot, board, seconds, recorded[name], wbc_solver))
+        rows.append(bench_pair(robot, board, seconds, recorded[name], wbc_solver, profile))
     print(bench_table(rows))
     if json_path is not None:
 
