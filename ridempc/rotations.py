@@ -23,6 +23,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 __all__ = [
+    "euler_of_quaternions",
     "matrix_of_rpy",
     "matrix_to_quaternion",
     "pitch_of",
@@ -78,6 +79,16 @@ def roll_of(quat_wxyz: Array) -> float:
     """The z-y-x roll :math:`\\phi` [rad] of a unit quaternion, about the body's own x axis."""
     w, x, y, z = np.asarray(quat_wxyz, dtype=float).tolist()
     return math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+
+
+def euler_of_quaternions(quats_wxyz: Array) -> tuple[Array, Array, Array]:
+    """Roll, pitch, yaw [rad] of every unit quaternion (w, x, y, z) in ``quats_wxyz``
+    [..., 4], each of the shape ``quats_wxyz.shape[:-1]``: a log's, in one NumPy pass."""
+    w, x, y, z = (quats_wxyz[..., i] for i in range(4))
+    roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
+    yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw
 
 
 def rpy_of_matrix(rotation: Array) -> tuple[float, float, float]:

@@ -176,3 +176,24 @@ def test_skew_matches_the_formula(rng: np.random.Generator) -> None:
 )
 def test_wrap_angle_is_into_minus_pi_to_pi(angle: float, wrapped: float) -> None:
     assert rotations.wrap_angle(angle) == pytest.approx(wrapped, abs=ROUNDING)
+
+
+def test_euler_of_quaternions_is_the_logs_formulas_over_a_whole_log(
+    rng: np.random.Generator,
+) -> None:
+    """Bit for bit the vectorised formulas of sim/metrics.py, sim/plots.py and
+    boards/hovershoes/identify.py, and the scalar helpers' angles to rounding."""
+    quats = _quaternions(rng).reshape(-1, 2, 4)
+    w, x, y, z = (quats[..., i] for i in range(4))
+    roll, pitch, yaw = rotations.euler_of_quaternions(quats)
+    np.testing.assert_array_equal(
+        roll, np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x**2 + y**2))
+    )
+    np.testing.assert_array_equal(pitch, np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0)))
+    np.testing.assert_array_equal(
+        yaw, np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    )
+    for k, quat in enumerate(quats[:, 0]):
+        assert rotations.roll_of(quat) == pytest.approx(roll[k, 0], abs=ROUNDING)
+        assert rotations.pitch_of(quat) == pytest.approx(pitch[k, 0], abs=ROUNDING)
+        assert rotations.yaw_of(quat) == pytest.approx(yaw[k, 0], abs=ROUNDING)

@@ -50,7 +50,7 @@ from ridempc.boards.identification import (
     r_squared,
 )
 from ridempc.robots import load_robot
-from ridempc.rotations import quaternion_to_matrix
+from ridempc.rotations import euler_of_quaternions, quaternion_to_matrix
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
@@ -142,8 +142,7 @@ def _trial_inputs(rng: np.random.Generator, side: int) -> TrialInputs:
 
 
 def _yaw(quat: Array) -> Array:
-    w, x, y, z = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
-    return np.unwrap(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+    return np.unwrap(euler_of_quaternions(quat)[2])
 
 
 def run_trials(
