@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 __all__ = [
     "euler_of_quaternions",
+    "exp3",
     "matrix_of_rpy",
     "matrix_to_quaternion",
     "pitch_of",
@@ -111,6 +112,12 @@ def rotation_y(angle: float) -> Array:
 def rotation_z(angle: float) -> Array:
     """:math:`R_z(\\psi)` [3 x 3], a rotation about z by ``angle`` [rad]."""
     return matrix_of_rpy(0.0, 0.0, angle)
+
+
+def exp3(rotation_vector: Array) -> Array:
+    """:math:`\\exp([\\omega]_\\times)` [3 x 3], the rotation by :math:`|\\omega|` [rad] about
+    :math:`\\omega / |\\omega|` (Rodrigues' formula, Pinocchio's ``exp3``)."""
+    return np.asarray(pin.exp3(np.asarray(rotation_vector, dtype=float)))
 
 
 def skew(vector: Array) -> Array:

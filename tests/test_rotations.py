@@ -197,3 +197,17 @@ def test_euler_of_quaternions_is_the_logs_formulas_over_a_whole_log(
         assert rotations.roll_of(quat) == pytest.approx(roll[k, 0], abs=ROUNDING)
         assert rotations.pitch_of(quat) == pytest.approx(pitch[k, 0], abs=ROUNDING)
         assert rotations.yaw_of(quat) == pytest.approx(yaw[k, 0], abs=ROUNDING)
+
+
+def _rodrigues(axis, angle):  # baselines/quadruped_skateboard.py, about a unit axis
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def test_exp3_matches_rodrigues_formula(rng: np.random.Generator) -> None:
+    axes = rng.normal(size=(COUNT, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    for axis, angle in zip(axes, rng.uniform(0.0, math.pi, COUNT), strict=True):
+        np.testing.assert_allclose(
+            rotations.exp3(angle * axis), _rodrigues(axis, angle), atol=ROUNDING
+        )

@@ -108,7 +108,7 @@ from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
-from ridempc.rotations import quaternion_to_matrix, rotation_y, rotation_z
+from ridempc.rotations import exp3, quaternion_to_matrix, rotation_y, rotation_z
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -143,10 +143,8 @@ def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:
     axis = np.array(
         [error[2, 1] - error[1, 2], error[0, 2] - error[2, 0], error[1, 0] - error[0, 1]]
     )
-    axis /= np.linalg.norm(axis)
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    step = np.eye(3) + math.sin(limit) * k + (1.0 - math.cos(limit)) * (k @ k)
-    return step @ current
+    axis *= limit / np.linalg.norm(axis)
+    return exp3(axis) @ current
 
 
 def _foot_radius(robot: Robot) -> float:
