@@ -465,3 +465,23 @@ def test_joint_values_read_their_array_by_name() -> None:
     assert dict(values) == {"hip": 0.1, "knee": -0.2}
     with pytest.raises(KeyError):
         values["ankle"]
+
+
+def test_two_points_line_is_the_svds_to_rounding() -> None:
+    """A board's two contact points (a line foot alone on a Hovershoe): their line, taken as
+    d/|d| without an SVD, gives the normal and heading the SVD of the points gives."""
+    from ridempc.estimation.board import _normal, _unit_rejection
+
+    rng = np.random.default_rng(39)
+    up = np.array([0.0, 0.0, 1.0])
+    for _ in range(500):
+        points = rng.normal(size=(2, 3)) * [0.1, 0.1, 0.01]
+        centred = points - points.mean(axis=0)
+        normal, line = _normal(centred, up)
+        _, _, vt = lapack.svd(centred)
+        assert line is not None
+        np.testing.assert_allclose(abs(line @ vt[0]), 1.0, atol=1e-14)
+        wanted, _ = _unit_rejection(up, vt[0])
+        np.testing.assert_allclose(normal, wanted if wanted[2] >= 0.0 else -wanted, atol=1e-14)
+    normal, line = _normal(np.zeros((2, 3)), up)  # one point twice: no line, the hint
+    assert line is None and np.array_equal(normal, up)

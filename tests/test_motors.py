@@ -146,6 +146,30 @@ def test_a_step_command_reaches_the_joint_after_the_delay(robot) -> None:
     assert np.all(delay == delay_steps(robot.motors[0].torque_delay, 1.0 / DEFAULT_PHYSICS_HZ))
 
 
+def test_each_motor_waits_its_own_delay(robot) -> None:
+    """Motors with different delays (0 to 5 steps) in one driver: each torque of a ramp
+    reaches its joint exactly its own motor's delay later."""
+    import dataclasses
+
+    import mujoco
+
+    model = robot.spec().compile()
+    model.opt.timestep = 1.0 / DEFAULT_PHYSICS_HZ
+    data = mujoco.MjData(model)
+    motors = tuple(
+        dataclasses.replace(m, torque_delay=(k % 4) * 0.0011) for k, m in enumerate(robot.motors)
+    )
+    driver = MotorDriver(model, motors, np.arange(model.nu))
+    assert len(set(driver.delay.tolist())) > 2
+    gear = np.array([m.gear for m in motors])
+    unit = 1e-3 * driver.curve.peak
+    for k in range(20):
+        driver.command = _torque_command((k + 1) * unit)  # torque k + 1 computed at step k
+        driver.apply(data)
+        sent = np.maximum(k - driver.delay + 1, 0)  # the step's torque, or none yet
+        np.testing.assert_allclose(data.ctrl * gear, sent * unit, rtol=1e-12, atol=0.0)
+
+
 def test_the_driver_applies_the_curve(robot) -> None:
     driver, data = _driver(robot)
     dof = driver._dof

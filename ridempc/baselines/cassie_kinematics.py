@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 from ridempc.errors import ConfigError
 from ridempc.robots.pinocchio_model import PinocchioRobot, build_pinocchio_robot
 from ridempc.robots.robot import Robot
+from ridempc.rotations import quaternion_to_matrix, rotation_z, rpy_of_matrix
 
 __all__ = [
     "SIDES",
@@ -43,7 +44,6 @@ __all__ = [
     "KinematicState",
     "LegIndices",
     "VirtualLeg",
-    "rpy_of",
 ]
 
 Array = NDArray[np.float64]
@@ -51,19 +51,6 @@ Array = NDArray[np.float64]
 SIDES: tuple[str, str] = ("left", "right")
 TARSUS_OFFSET: float = np.radians(13.0)  # [rad] eq. (3): tarsus = 13 deg - knee, springs at rest
 LEG_MOTORS: tuple[str, ...] = ("hip_roll", "hip_yaw", "hip_pitch", "knee", "toe")
-
-
-def rpy_of(rotation: Array) -> tuple[float, float, float]:
-    """Roll, pitch, yaw [rad] of :math:`R = R_z(\\psi) R_y(\\theta) R_x(\\phi)`."""
-    roll = float(np.arctan2(rotation[2, 1], rotation[2, 2]))
-    pitch = float(-np.arcsin(np.clip(rotation[2, 0], -1.0, 1.0)))
-    yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
-    return roll, pitch, yaw
-
-
-def _rot_z(angle: float) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 @dataclass(frozen=True)
@@ -271,9 +258,7 @@ class CassieKinematics:
 
     def base_rotation(self, imu_quaternion: Array) -> Array:
         """Pelvis orientation :math:`R_{WB}` from the IMU quaternion (w, x, y, z)."""
-        w, x, y, z = np.asarray(imu_quaternion, dtype=float)
-        rotation = pin.Quaternion(w, x, y, z).normalized().toRotationMatrix()
-        return np.asarray(rotation @ self._imu_to_base.T)
+        return quaternion_to_matrix(imu_quaternion) @ self._imu_to_base.T
 
     def configuration(self, rotation: Array, joint_position: Array) -> Array:
         """Pinocchio configuration: base at the origin with ``rotation``, encoded joints set.
@@ -323,8 +308,8 @@ class CassieKinematics:
         pin.updateFramePlacements(model, data)
         com_world = pin.centerOfMass(model, data, q, v, False)
         vcom_world = np.array(data.vcom[0])
-        roll, pitch, yaw = rpy_of(rotation)
-        heading = _rot_z(yaw).T  # world-aligned -> heading frame
+        roll, pitch, yaw = rpy_of_matrix(rotation)
+        heading = rotation_z(yaw).T  # world-aligned -> heading frame
         contacts = np.empty((4, 3))
         contact_velocity = np.zeros(3)
         lengths = np.empty(2)

@@ -25,15 +25,11 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.baselines.cassie_kinematics import SIDES, CassieKinematics, LegIndices
+from ridempc.rotations import skew
 
 __all__ = ["FootLoad", "StandingStatics"]
 
 Array = NDArray[np.float64]
-
-
-def _skew(vector: Array) -> Array:
-    x, y, z = vector
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
 @dataclass(frozen=True)
@@ -71,7 +67,7 @@ class StandingStatics:
             frame = self.kinematics.legs[side].foot_frame
             jac = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)
             lever = np.asarray(load.point) - data.oMf[frame].translation
-            point_jac = jac[:3] - _skew(lever) @ jac[3:]
+            point_jac = jac[:3] - skew(lever) @ jac[3:]
             tau -= point_jac.T @ np.asarray(load.force)
         return tau
 

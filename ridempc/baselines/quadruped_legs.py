@@ -36,19 +36,13 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
-from ridempc.estimation.rotations import wrap_angle
 from ridempc.robots.pinocchio_model import PinocchioRobot
+from ridempc.rotations import wrap_angle
 
-__all__ = ["LegKinematics", "QuadrupedLegs", "rotation_y"]
+__all__ = ["LegKinematics", "QuadrupedLegs"]
 
 Array = NDArray[np.float64]
 STRUCTURE_TOLERANCE: float = 1e-9  # [m] offsets that must vanish for the closed-form IK
-
-
-def rotation_y(angle: float) -> Array:
-    """:math:`R_y(\\theta)`, a rotation about y by ``angle`` [rad]."""
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _sagittal(vector: Array) -> complex:

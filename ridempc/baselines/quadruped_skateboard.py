@@ -90,7 +90,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.baselines.quadruped_legs import QuadrupedLegs, rotation_y
+from ridempc.baselines.quadruped_legs import QuadrupedLegs
 from ridempc.baselines.quadruped_skateboard_gains import (
     DEFAULT_GAINS_FILE,
     QuadrupedSkateboardGains,
@@ -108,6 +108,7 @@ from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
+from ridempc.rotations import exp3, quaternion_to_matrix, rotation_y, rotation_z
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -133,17 +134,6 @@ def steering_roll(yaw_rate: float, speed: float, steer_gain: float, min_speed: f
     return -math.asin(max(-1.0, min(1.0, yaw_rate / (steer_gain * speed))))
 
 
-def _rotation_z(angle: float) -> Array:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def _quat_to_matrix(quat_wxyz: Array) -> Array:
-    rotation = np.empty(9)
-    mujoco.mju_quat2Mat(rotation, np.asarray(quat_wxyz, dtype=float))
-    return rotation.reshape(3, 3)
-
-
 def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:
     """``wanted``, or the rotation ``limit`` [rad] from ``current`` towards it."""
     error = wanted @ current.T
@@ -153,10 +143,8 @@ def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:
     axis = np.array(
         [error[2, 1] - error[1, 2], error[0, 2] - error[2, 0], error[1, 0] - error[0, 1]]
     )
-    axis /= np.linalg.norm(axis)
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    step = np.eye(3) + math.sin(limit) * k + (1.0 - math.cos(limit)) * (k @ k)
-    return step @ current
+    axis *= limit / np.linalg.norm(axis)
+    return exp3(axis) @ current
 
 
 def _foot_radius(robot: Robot) -> float:
@@ -295,9 +283,9 @@ class QuadrupedSkateboardPD(Controller):
         q = np.asarray(sensors.joint_position[:n], dtype=float)
         dq = np.asarray(sensors.joint_velocity[:n], dtype=float)
         tau = np.asarray(sensors.motor_torque, dtype=float)
-        rotation_wb = _quat_to_matrix(sensors.imu.quaternion)
+        rotation_wb = quaternion_to_matrix(sensors.imu.quaternion)
         yaw = math.atan2(rotation_wb[1, 0], rotation_wb[0, 0])
-        rotation_lb = _rotation_z(-yaw) @ rotation_wb  # level frame, yawed with the trunk
+        rotation_lb = rotation_z(-yaw) @ rotation_wb  # level frame, yawed with the trunk
         wx, wy, wz = (float(v) for v in sensors.imu.angular_velocity)
         omega_cross = np.array([[0.0, -wz, wy], [wz, 0.0, -wx], [-wy, wx, 0.0]])
         feet_b = np.empty((4, 3))
@@ -308,7 +296,7 @@ class QuadrupedSkateboardPD(Controller):
             velocities_b[i] = omega_cross @ feet_b[i] + jacobians[i] @ dq[joints]
         feet_l = feet_b @ rotation_lb.T
         heading = feet_l[self._front].mean(axis=0) - feet_l[~self._front].mean(axis=0)
-        rotation_fl = _rotation_z(-math.atan2(heading[1], heading[0]))
+        rotation_fl = rotation_z(-math.atan2(heading[1], heading[0]))
         rotation_fb = rotation_fl @ rotation_lb
         centroid = feet_l.mean(axis=0)
         feet = (feet_l - centroid) @ rotation_fl.T
@@ -446,7 +434,7 @@ class QuadrupedSkateboardPD(Controller):
 
         # trunk: level, pitch held, starting yaw over the feet; centre of mass over the deck
         deck_point = -self.foot_radius * state.deck.normal
-        wanted_rotation = _rotation_z(self._relative_yaw) @ rotation_y(posture.pitch)
+        wanted_rotation = rotation_z(self._relative_yaw) @ rotation_y(posture.pitch)
         rotation = _limited_rotation(state.trunk_rotation, wanted_rotation, posture.max_rotation)
         com_target = np.array([posture.com_x, -shift])  # over the feet's centroid
         origin = np.append(com_target - (rotation @ state.com)[:2], self._height)

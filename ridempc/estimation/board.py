@@ -39,8 +39,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.estimation.lapack import svd
-from ridempc.estimation.rotations import rpy_of_matrix
 from ridempc.estimation.state import BoardEstimate
+from ridempc.rotations import rpy_of_matrix
 
 __all__ = ["estimate_board"]
 
@@ -74,6 +74,13 @@ def _normal(centred: Array, up_hint: Array) -> tuple[Array, Array | None]:
     """The plane's upward unit normal, from the points less their centroid [m], and the
     unit direction of their line when they lie on one (else None)."""
     count = len(centred)
+    if count == 2:  # two points' line, d/|d| (the SVD's to rounding, without its 5 us)
+        difference = centred[1] - centred[0]
+        length = math.sqrt(difference @ difference)
+        if length > 0.0:
+            line = difference / length
+            normal, _ = _unit_rejection(up_hint, line)
+            return (normal if normal[2] >= 0.0 else -normal), line
     if count >= 2:
         _, singular, vt = svd(centred)
     else:

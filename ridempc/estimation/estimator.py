@@ -44,10 +44,10 @@ from ridempc.estimation.leg_odometry import LegOdometryModel
 from ridempc.estimation.legs import LegKinematics, LegReading
 from ridempc.estimation.loop_closure import LoopClosure
 from ridempc.estimation.parameters import EstimatorParameters
-from ridempc.estimation.rotations import matrix_of_rpy
 from ridempc.estimation.state import BoardEstimate, EstimatedState, JointValues
 from ridempc.robots.pinocchio_model import PinocchioRobot, build_pinocchio_robot
 from ridempc.robots.robot import Robot
+from ridempc.rotations import matrix_of_rpy
 from ridempc.sim.sensors import SensorPacket, VioReading
 
 __all__ = ["StateEstimator"]

@@ -24,8 +24,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
-from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.robots.pinocchio_model import PinocchioRobot
+from ridempc.rotations import matrix_to_quaternion
 
 __all__ = ["GRAVITY", "BaseAttitude", "ImuMount"]
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.estimation.rotations import quaternion_to_matrix, yaw_of
+from ridempc.rotations import quaternion_to_matrix, yaw_of
 
 __all__ = ["BoardEstimate", "EstimatedState", "JointValues"]
 

@@ -21,16 +21,11 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.robots.robot import Robot
+from ridempc.rotations import quaternion_to_matrix
 
 __all__ = ["CoordinateMap", "PinocchioRobot", "build_pinocchio_robot"]
 
 Array = NDArray[np.float64]
-
-
-def _quat_wxyz_to_matrix(quat: Array) -> Array:
-    rotation = np.empty(9)
-    mujoco.mju_quat2Mat(rotation, quat)
-    return rotation.reshape(3, 3)
 
 
 @dataclass(frozen=True)
@@ -78,19 +73,19 @@ class CoordinateMap:
     def velocity_map(self, qpos: Array) -> Array:
         """:math:`T(q)` with :math:`\\dot q_{mj} = T v_{pin}` [nv x nv]."""
         transform = np.eye(self.nv)
-        transform[:3, :3] = _quat_wxyz_to_matrix(qpos[3:7])
+        transform[:3, :3] = quaternion_to_matrix(qpos[3:7])
         return transform
 
     def qvel_to_pinocchio(self, qpos: Array, qvel: Array) -> Array:
         """MuJoCo qvel -> Pinocchio v (base linear velocity into the base frame)."""
         v = np.array(qvel, dtype=float)
-        v[:3] = _quat_wxyz_to_matrix(qpos[3:7]).T @ qvel[:3]
+        v[:3] = quaternion_to_matrix(qpos[3:7]).T @ qvel[:3]
         return v
 
     def qvel_from_pinocchio(self, qpos: Array, v: Array) -> Array:
         """Pinocchio v -> MuJoCo qvel."""
         qvel = np.array(v, dtype=float)
-        qvel[:3] = _quat_wxyz_to_matrix(qpos[3:7]) @ v[:3]
+        qvel[:3] = quaternion_to_matrix(qpos[3:7]) @ v[:3]
         return qvel
 
 

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ridempc.robots.robot import Robot
+from ridempc.rotations import euler_of_quaternions
 from ridempc.scenarios.scenario import PUSH_OFF_WINDOW, Scenario
 from ridempc.sim.simulation import RunResult
 
@@ -44,8 +45,7 @@ def _tilt(quaternions: np.ndarray) -> np.ndarray:
 
 def board_roll(quaternions: np.ndarray) -> np.ndarray:
     """Roll about the body's own x axis [rad] (z-y-x Euler angles), for (w, x, y, z)."""
-    w, x, y, z = (quaternions[:, i] for i in range(4))
-    return np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x**2 + y**2))
+    return euler_of_quaternions(quaternions)[0]
 
 
 def _lateral_spacing(positions: np.ndarray, yaw: np.ndarray) -> np.ndarray:

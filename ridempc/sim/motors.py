@@ -63,11 +63,9 @@ class MotorCommand:
         )
 
     def is_finite(self) -> bool:
-        # the arrays' own all(): np.all's wrapper costs 3 us, five times a tick
-        return all(
-            np.isfinite(a).all()
-            for a in (self.torque, self.position, self.velocity, self.kp, self.kd)
-        )
+        # the five arrays in one test: five isfinite().all() took 5 us a tick, this 1.5
+        values = np.concatenate((self.torque, self.position, self.velocity, self.kp, self.kd))
+        return bool(np.logical_and.reduce(np.isfinite(values)))
 
 
 def delay_steps(delay: float, timestep: float) -> int:
@@ -103,9 +101,17 @@ class MotorDriver:
         self.curve = TorqueSpeedCurve.of(motors)
         step = float(model.opt.timestep)
         self.delay = np.array([delay_steps(m.torque_delay, step) for m in motors], dtype=np.int64)
-        # the delay line: row k % len holds the torque computed at step k
-        self._line = np.zeros((int(self.delay.max()) + 1, len(motors)))
-        self._columns = np.arange(len(motors))
+        # the delay line: row k % len holds the torques the joints receive at step k, each
+        # motor's written ``delay`` rows ahead when computed (read whole: one row, where
+        # gathering each motor's own past row took three index operations)
+        length = int(self.delay.max()) + 1
+        self._line = np.zeros((length, len(motors)))
+        self._writes = [
+            np.ravel_multi_index(
+                ((slot + self.delay) % length, np.arange(len(motors))), (length, len(motors))
+            )
+            for slot in range(length)
+        ]
         self._step = 0
         self._applied = np.zeros(len(motors))
         self.demand = np.zeros(len(motors))
@@ -137,8 +143,11 @@ class MotorDriver:
         self.available = self.curve.limit(qd)
         slot = self._step % len(self._line)
         # min(max()) rather than np.clip, whose wrapper cost 3 of the old 15 us per call
-        self._line[slot] = np.minimum(np.maximum(self.demand, -self.available), self.available)
-        self._applied = self._line[(self._step - self.delay) % len(self._line), self._columns]
+        self._line.put(
+            self._writes[slot],
+            np.minimum(np.maximum(self.demand, -self.available), self.available),
+        )
+        self._applied = self._line[slot].copy()
         self._step += 1
         data.ctrl[self._actuators] = self._applied / self._gear
 

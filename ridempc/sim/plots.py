@@ -9,6 +9,7 @@ import numpy as np
 
 from ridempc.io import atomic_savefig
 from ridempc.robots.robot import Robot
+from ridempc.rotations import euler_of_quaternions
 
 __all__ = ["plot_run"]
 
@@ -57,9 +58,7 @@ def plot_run(log: dict[str, np.ndarray], robot: Robot | None, path: Path, title:
         _plot_estimate(axes[4], t, log)
     if board:
         quat = log["board_quaternion"]
-        w, x, y, z = (quat[..., i] for i in range(4))
-        pitch = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
-        roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x**2 + y**2))
+        roll, pitch, _ = euler_of_quaternions(quat)
         for i in range(quat.shape[1]):
             axes[-1].plot(t, np.degrees(pitch[:, i]), label=f"platform {i} pitch")
             axes[-1].plot(t, np.degrees(roll[:, i]), ls=":", label=f"platform {i} roll")

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
+from ridempc.rotations import yaw_of
 from ridempc.units import CheckedModel, Real
 
 __all__ = ["GroundTruth", "ImuReading", "SensorNoise", "SensorPacket", "SensorSuite", "VioReading"]
@@ -108,11 +109,6 @@ class SensorPacket:
     motor_torque: Array
     vio: VioReading | None
     truth: GroundTruth | None = None
-
-
-def _yaw_of(quat_wxyz: Array) -> float:
-    w, x, y, z = quat_wxyz
-    return float(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
 
 
 class SensorSuite:
@@ -208,7 +204,7 @@ class SensorSuite:
         reading = VioReading(
             stamp=tick / self._physics_hz,
             position=data.xpos[self._base] + self._noise(n.vio_position_std, 3),
-            yaw=_yaw_of(quat) + float(self._noise(n.vio_yaw_std, 1)[0]),
+            yaw=yaw_of(quat) + float(self._noise(n.vio_yaw_std, 1)[0]),
             velocity=vel_world[3:] + self._noise(n.vio_velocity_std, 3),
             yaw_rate=float(vel_world[2]) + float(self._noise(n.vio_yaw_rate_std, 1)[0]),
         )

@@ -31,6 +31,7 @@ from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError, SimulationDiverged
 from ridempc.heap import frozen_heap
+from ridempc.rotations import yaw_of
 from ridempc.scenarios.scenario import Disturbance, Scenario
 from ridempc.sim.changes import ScheduledChanges
 from ridempc.sim.clock import Rate
@@ -73,11 +74,6 @@ class RunResult:
     @property
     def fell(self) -> bool:
         return self.fall_time is not None
-
-
-def _yaw(quat_wxyz: Array) -> float:
-    w, x, y, z = quat_wxyz
-    return float(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
 
 
 class Simulation:
@@ -186,7 +182,7 @@ class Simulation:
         base = scene.base_body
         velocity = np.empty(6)
         mujoco.mj_objectVelocity(scene.model, data, mujoco.mjtObj.mjOBJ_BODY, base, velocity, 0)
-        yaw = _yaw(data.xquat[base])
+        yaw = yaw_of(data.xquat[base])
         command = self.scenario.command_at(t)
         recorder.append(
             time=t,

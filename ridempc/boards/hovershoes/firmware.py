@@ -50,7 +50,7 @@ def pitch_from_quaternion(quat_wxyz: np.ndarray) -> float:
         :math:`\\theta = \\operatorname{atan2}(-R_{zx}, R_{zz})`, positive when the front
         of the platform dips (a positive rotation about the shoe's +y axis).
     """
-    w, x, y, z = quat_wxyz
+    w, x, y, z = np.asarray(quat_wxyz, dtype=float).tolist()  # Python floats: NumPy's scalars
     r_zx = 2.0 * (x * z - w * y)
     r_zz = 1.0 - 2.0 * (x * x + y * y)
     return math.atan2(-r_zx, r_zz)

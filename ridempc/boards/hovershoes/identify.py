@@ -50,6 +50,7 @@ from ridempc.boards.identification import (
     r_squared,
 )
 from ridempc.robots import load_robot
+from ridempc.rotations import euler_of_quaternions, quaternion_to_matrix
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
@@ -141,8 +142,7 @@ def _trial_inputs(rng: np.random.Generator, side: int) -> TrialInputs:
 
 
 def _yaw(quat: Array) -> Array:
-    w, x, y, z = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
-    return np.unwrap(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+    return np.unwrap(euler_of_quaternions(quat)[2])
 
 
 def run_trials(
@@ -186,7 +186,7 @@ def run_trials(
     trials = []
     for i, shoe in enumerate(inputs):
         quat = log["board_quaternion"][:, i]
-        rotation = np.array([_matrix(q) for q in quat])
+        rotation = np.array([quaternion_to_matrix(q) for q in quat])
         omega = log["board_angular_velocity"][:, i]
         velocity = log["board_velocity"][:, i]
         heading = rotation[:, :, 0].copy()
@@ -212,12 +212,6 @@ def run_trials(
             )
         )
     return trials[0], trials[1]
-
-
-def _matrix(quat: Array) -> Array:
-    out = np.empty(9)
-    mujoco.mju_quat2Mat(out, quat)
-    return out.reshape(3, 3)
 
 
 def _response(num: list[float], den: list[float], u: Array, dt: float) -> Array:

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
 from ridempc.errors import RidempcError
+from ridempc.rotations import pitch_of, yaw_of
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.scene import BOARD_PREFIX, build_scene
 from ridempc.sim.simulation import Simulation
@@ -113,13 +114,6 @@ class Trial:
         return float(self.time[1] - self.time[0])
 
 
-def _pitch_yaw(quat_wxyz: NDArray[np.float64]) -> tuple[float, float]:
-    w, x, y, z = quat_wxyz
-    pitch = float(np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0)))
-    yaw = float(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
-    return pitch, yaw
-
-
 def run_trial(
     board: Board,
     dead_weight: float,
@@ -158,7 +152,7 @@ def run_trial(
         data.xfrc_applied[bar, 3:] -= k * axes[:, 0]
         if tick[0] % every == 0:
             mujoco.mj_objectVelocity(m, data, mujoco.mjtObj.mjOBJ_BODY, chassis, velocity, 1)
-            pitch, yaw = _pitch_yaw(data.xquat[chassis])
+            pitch, yaw = pitch_of(data.xquat[chassis]), yaw_of(data.xquat[chassis])
             linear = data.qvel[free_dof : free_dof + 3]
             rows.append(
                 [

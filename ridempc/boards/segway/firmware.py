@@ -27,20 +27,13 @@ above the top speed (the tilt-back of real transporters).
 
 from __future__ import annotations
 
-import numpy as np
-
 from ridempc.boards.firmware import BoardIO, Firmware
 from ridempc.boards.parameters import BoardParameters
 from ridempc.boards.segway.parameters import SegwayParameters
 from ridempc.errors import ConfigError
+from ridempc.rotations import pitch_of
 
 __all__ = ["SegwayFirmware"]
-
-
-def platform_pitch(quat_wxyz: np.ndarray) -> float:
-    """Pitch of the platform about its lateral axis, positive nose down [rad]."""
-    w, x, y, z = quat_wxyz
-    return float(np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0)))
 
 
 class SegwayFirmware(Firmware):
@@ -61,11 +54,12 @@ class SegwayFirmware(Firmware):
 
     def update(self) -> None:
         p, g, io = self.segway, self.segway.gains, self.io
-        pitch = platform_pitch(io.sensor("platform_quat"))
+        pitch = pitch_of(io.sensor("platform_quat"))  # positive nose down
         gyro = io.sensor("platform_gyro")
         wheel_rate = 0.5 * float(io.sensor("left_wheel_vel")[0] + io.sensor("right_wheel_vel")[0])
         speed = p.wheel_radius * (wheel_rate + float(gyro[1]))
-        excess = max(abs(speed) - p.top_speed, 0.0) * np.sign(speed)
+        # in Python floats (np.sign and np.clip on a scalar cost 1 and 5 us): the same numbers
+        excess = max(abs(speed) - p.top_speed, 0.0) * ((speed > 0.0) - (speed < 0.0))
         total = (
             g.pitch_kp * pitch
             + g.pitch_kd * float(gyro[1])
@@ -73,7 +67,7 @@ class SegwayFirmware(Firmware):
             + g.pushback_gain * excess
         )
         knee = float(io.sensor("knee_bar_angle")[0])
-        yaw_rate_ref = float(np.clip(g.turn_gain * knee, -g.max_yaw_rate, g.max_yaw_rate))
+        yaw_rate_ref = min(max(g.turn_gain * knee, -g.max_yaw_rate), g.max_yaw_rate)
         yaw = g.yaw_rate_kp * (yaw_rate_ref - float(gyro[2]))
         left = io.actuate("left_wheel", 0.5 * total - yaw)
         right = io.actuate("right_wheel", 0.5 * total + yaw)

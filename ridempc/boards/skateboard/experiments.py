@@ -35,6 +35,7 @@ from ridempc.boards.identification import IdentificationFailed
 from ridempc.boards.skateboard.model import DECK, PLATFORM_SITE
 from ridempc.boards.skateboard.parameters import SkateboardParameters
 from ridempc.boards.skateboard.reduced import steering_axle_distances
+from ridempc.rotations import roll_of, yaw_of
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sim.scene import BOARD_PREFIX, Scene, build_scene
 from ridempc.sim.simulation import Simulation
@@ -181,13 +182,6 @@ def skateboard_scene(board: Board, dead_weight: float) -> Scene:
     return build_scene(None, PHYSICS_HZ, board=board, dead_weight=dead_weight)
 
 
-def _roll_and_heading(quat: Array) -> tuple[float, float]:
-    w, x, y, z = quat
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    heading = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-    return roll, heading
-
-
 class _Experimenter:
     """The ``external`` hook: applies the scripted forces and records a row each step."""
 
@@ -223,7 +217,7 @@ class _Experimenter:
     def __call__(self, t: float, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         deck, weight = self._deck, self._weight
         rotation = data.xmat[deck].reshape(3, 3)
-        roll, heading = _roll_and_heading(data.xquat[deck])
+        roll, heading = roll_of(data.xquat[deck]), yaw_of(data.xquat[deck])
         mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_XBODY, deck, self._velocity, 0)
         omega_world, velocity = self._velocity[:3], self._velocity[3:]
         roll_rate = float(rotation[:, 0] @ omega_world)
