@@ -19,8 +19,10 @@ in the base frame), everything the tasks and constraints read:
   :math:`\\dot J_{loop} v`, so that :math:`\\ddot r = J_{loop} \\ddot q + \\dot J_{loop} v`.
 
 The drifts are Pinocchio's classical accelerations at :math:`\\ddot q = 0`
-(``forwardKinematics(q, v, 0)`` then ``getFrameClassicalAcceleration``): the spatial
-acceleration's linear part plus :math:`\\omega \\times \\dot p`.
+(``getFrameClassicalAcceleration``): the spatial acceleration's linear part plus
+:math:`\\omega \\times \\dot p`. ``computeAllTerms`` leaves in its data the joints'
+accelerations of its bias pass, the motion at :math:`\\ddot q = 0`, which is what
+``forwardKinematics(q, v, 0)`` would compute again (checked in the WBC's tests).
 """
 
 from __future__ import annotations
@@ -164,8 +166,10 @@ class WholeBodyModel:
         self._stiffness = self.pinocchio.spring_stiffness[self._stiff_v]
         self._spring_reference = self.pinocchio.spring_reference[self._stiff_v]
         self._damping = np.array(model.damping, dtype=float)
-        self._zero = np.zeros(model.nv)
-        self._lower = np.tril_indices(model.nv, -1)
+        # M's strict lower triangle, and the upper entries it mirrors, as flat indices
+        lower_rows, lower_cols = np.tril_indices(model.nv, -1)
+        self._lower = lower_rows * model.nv + lower_cols
+        self._mirror = lower_cols * model.nv + lower_rows
         # every frame read per tick: the base, the sites, then each closure's two anchors
         pairs = self.closure.pairs
         self._frames = (
@@ -262,27 +266,32 @@ class WholeBodyModel:
         model, data = self.model, self.data
         q = np.asarray(q, dtype=float)
         v = np.asarray(v, dtype=float)
-        pin.computeAllTerms(model, data, q, v)  # M (upper triangle), h, joint Jacobians, CoM
+        nv = model.nv
+        # M (upper triangle), h, joint Jacobians, CoM and the joints' motion at qdd = 0
+        pin.computeAllTerms(model, data, q, v)
         mass = np.array(data.M)
-        mass[self._lower] = mass.T[self._lower]  # Pinocchio fills the upper triangle
-        bias = np.array(data.nle)
-        com_jacobian = np.array(data.Jcom)
-        pin.forwardKinematics(model, data, q, v, self._zero)  # accelerations = drifts
+        flat = mass.reshape(-1)
+        flat.put(self._lower, flat.take(self._mirror))  # Pinocchio fills the upper triangle
         pin.updateFramePlacements(model, data)
         pin.centerOfMass(model, data, pin.KinematicLevel.ACCELERATION, False)
         com = PointKinematics(
-            np.array(data.com[0]), np.array(data.vcom[0]), com_jacobian, np.array(data.acom[0])
+            np.array(data.com[0]),
+            np.array(data.vcom[0]),
+            np.array(data.Jcom),
+            np.array(data.acom[0]),
         )
         frames = self._frames
-        positions = np.empty((len(frames), 3))
-        rotations = np.empty((len(frames), 3, 3))
-        jacobians = np.empty((len(frames), 3, model.nv))
-        drifts = np.empty((len(frames), 3))
+        count = len(frames)
+        positions = np.empty((count, 3))
+        rotations = np.empty((self._site_rows.stop, 3, 3))
+        jacobians = np.empty((count, 3, nv))
+        drifts = np.empty((count, 3))
         placements = data.oMf
+        rotated = self._site_rows.stop  # the base and the sites
         for k, frame in enumerate(frames):
             placement = placements[frame]
             positions[k] = placement.translation
-            if k < self._site_rows.stop:  # the base and the sites
+            if k < rotated:
                 rotations[k] = placement.rotation
             jacobians[k] = pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3]
             drifts[k] = pin.getFrameClassicalAcceleration(model, data, frame, WORLD_ALIGNED).linear
@@ -292,7 +301,7 @@ class WholeBodyModel:
             q=q,
             v=v,
             mass_matrix=mass,
-            bias=bias,
+            bias=np.array(data.nle),
             passive=self.passive_torque(q, v),
             base_rotation=rotations[0],
             base_angular_velocity=v[3:6].copy(),
@@ -303,6 +312,6 @@ class WholeBodyModel:
             ),
             site_rotation=rotations[sites],
             loop_residual=(positions[first] - positions[second]).ravel(),
-            loop_jacobian=(jacobians[first] - jacobians[second]).reshape(-1, model.nv),
+            loop_jacobian=(jacobians[first] - jacobians[second]).reshape(-1, nv),
             loop_drift=(drifts[first] - drifts[second]).ravel(),
         )
