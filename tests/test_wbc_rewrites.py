@@ -8,10 +8,15 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from ridempc.estimation.state import BoardEstimate
 from ridempc.robots import load_robot
+from ridempc.wbc.contacts import platform_rotation
+from ridempc.wbc.in_flight import TorquesInFlight
 from ridempc.wbc.model import WholeBodyModel
+from ridempc.wbc.platforms import RollingPlatform
 
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+DT = 0.002  # the WBC's tick [s]
 
 
 @pytest.fixture(scope="module", params=["cassie", "cyberdog2"])
@@ -56,3 +61,54 @@ def test_model_update_matches_pinocchio_call_by_call(model: WholeBodyModel) -> N
         pin.centerOfMass(pm, reference, q, v, np.zeros(pm.nv))
         np.testing.assert_allclose(terms.com.drift, reference.acom[0], rtol=0, atol=1e-10)
         np.testing.assert_allclose(terms.com.position, reference.com[0], rtol=0, atol=1e-14)
+
+
+def _least_forces_numpy(
+    in_flight: TorquesInFlight, recent: list[np.ndarray], foot_forces: np.ndarray
+) -> np.ndarray:
+    """The least site forces as first written, in NumPy (``in_flight``'s docstring)."""
+    lined = in_flight.site_motor >= 0
+    torques = np.array(recent)
+    spread = torques.max(axis=0) - torques.min(axis=0)
+    least = np.zeros(len(in_flight.site_motor))
+    least[lined] = spread[in_flight.site_motor[lined]] / in_flight.site_lever[lined]
+    half = 0.5 * np.maximum(foot_forces[in_flight.site_foot], 0.0)
+    return np.minimum(least, half)
+
+
+def test_least_forces_in_plain_floats_match_numpy() -> None:
+    robot = load_robot("cassie")
+    in_flight = TorquesInFlight(WholeBodyModel(robot), robot, DT)
+    rng = np.random.default_rng(3)
+    for tick in range(200):
+        torque = 20.0 * rng.normal(size=len(robot.motors))
+        in_flight.record(tick * DT, torque)
+        recent = [np.array(tau) for t, tau in in_flight._torques if t <= tick * DT]
+        feet = 150.0 * rng.normal(size=2)
+        got = in_flight.least_forces((tick + 1) * DT, feet)
+        if len(recent) < 2:
+            assert got is None
+            continue
+        assert got is not None
+        np.testing.assert_array_equal(got, _least_forces_numpy(in_flight, recent, feet))
+
+
+def test_platform_rotation_and_response_match_their_formulas() -> None:
+    """Pinocchio's ``rpyToMatrix`` is :math:`R_z R_y R_x`; the shoe's response in plain floats
+    is :math:`a^0 = (c_4 \\theta / m_s) e_x`, :math:`K = -e_x e_x^\\top / m_s`."""
+    platform = RollingPlatform(mass=2.7, drive=120.0, tread=0.09, height=0.11)
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        roll, pitch, yaw = rng.uniform(-np.pi, np.pi, size=3)
+        board = BoardEstimate(("foot",), rng.normal(size=3), yaw, pitch, roll, np.zeros(3), 0.1)
+        c, s = np.cos([roll, pitch, yaw]), np.sin([roll, pitch, yaw])
+        rx = np.array([[1, 0, 0], [0, c[0], -s[0]], [0, s[0], c[0]]])
+        ry = np.array([[c[1], 0, s[1]], [0, 1, 0], [-s[1], 0, c[1]]])
+        rz = np.array([[c[2], -s[2], 0], [s[2], c[2], 0], [0, 0, 1]])
+        np.testing.assert_allclose(platform_rotation(board), rz @ ry @ rx, rtol=0, atol=1e-15)
+        heading = np.array([c[2], s[2], 0.0])
+        response = platform.response(board)
+        np.testing.assert_allclose(response.drift, 120.0 * pitch / 2.7 * heading, atol=1e-14)
+        np.testing.assert_allclose(
+            response.coupling, -np.outer(heading, heading) / 2.7, rtol=0, atol=1e-15
+        )
