@@ -167,7 +167,7 @@ def build_contact_set(
             into, taken = _block_entries(sites, n)
             coupling.ravel()[into] = response.coupling.ravel()[taken]
             if platform.tread is not None:
-                offsets = lever @ rotation[:, 1] / platform.height  # y_s / h
+                offsets = lever.dot(rotation[:, 1]) / platform.height  # y_s / h
                 ratio = np.full(len(sites), 0.5 * platform.tread / platform.height)
                 tipping.append((sites, offsets, ratio))
         acceleration[sites] = centripetal

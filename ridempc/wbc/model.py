@@ -102,7 +102,7 @@ class ModelTerms(NamedTuple):
     @property
     def base_angular_velocity_world(self) -> Array:
         """:math:`\\omega_W = R_{WB}\\, \\omega_B` [rad/s]."""
-        return np.asarray(self.base_rotation @ self.base_angular_velocity)
+        return np.asarray(self.base_rotation.dot(self.base_angular_velocity))
 
 
 class WholeBodyModel:
