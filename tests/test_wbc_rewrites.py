@@ -10,7 +10,8 @@ import pytest
 
 from ridempc.estimation.state import BoardEstimate
 from ridempc.robots import load_robot
-from ridempc.wbc.contacts import platform_rotation
+from ridempc.wbc.constraints import ContactAccelerationConstraint, LinearConstraint
+from ridempc.wbc.contacts import ContactSet, platform_rotation
 from ridempc.wbc.in_flight import TorquesInFlight
 from ridempc.wbc.model import WholeBodyModel
 from ridempc.wbc.platforms import RollingPlatform
@@ -112,3 +113,48 @@ def test_platform_rotation_and_response_match_their_formulas() -> None:
         np.testing.assert_allclose(
             response.coupling, -np.outer(heading, heading) / 2.7, rtol=0, atol=1e-15
         )
+
+
+def test_contact_acceleration_rows_match_the_per_site_formula(model: WholeBodyModel) -> None:
+    """Every site's rows by one product with the held directions :math:`E` equal the
+    docstring's per site: :math:`E_s J_s`, :math:`-E_s K_{s\\cdot}` and
+    :math:`E_s (a_s - \\dot J_s v)`."""
+    layout = model.layout
+    constraint = ContactAccelerationConstraint(layout, model.site_partner, model.line_basis)
+    rng = np.random.default_rng(9)
+    n = layout.n_sites
+    for _ in range(10):
+        q, v = _random_state(model, rng)
+        terms = model.update(q, v)
+        contacts = ContactSet(
+            rng.random(n) < 0.7,
+            rng.normal(size=(n, 3, 3)),
+            rng.normal(size=(n, 3)),
+            coupling=rng.normal(size=(n, 3, n, 3)),
+        )
+        block = LinearConstraint(
+            np.zeros((constraint.rows, layout.size)),
+            np.empty(constraint.rows),
+            np.empty(constraint.rows),
+        )
+        constraint.fill_qp_constraint(block, terms, None, contacts)  # type: ignore[arg-type]
+        row = 0
+        order = [s for s in range(n) if model.site_partner[s] < 0]
+        order += [s for s in range(n) if model.site_partner[s] >= 0]
+        for s in order:
+            held = np.eye(3)
+            if model.site_partner[s] >= 0:
+                held = model.line_basis[s] @ terms.site_rotation[s].T
+            rows = slice(row, row + len(held))
+            wanted = held @ (contacts.acceleration[s] - terms.sites.drift[s])
+            coupling = contacts.coupling.reshape(n, 3, 3 * n)[s]
+            np.testing.assert_allclose(
+                block.matrix[rows, : layout.nv], held @ terms.sites.jacobian[s], atol=1e-12
+            )
+            np.testing.assert_allclose(
+                block.matrix[rows, layout.force], -held @ coupling, atol=1e-12
+            )
+            bound = wanted if contacts.active[s] else np.full(len(held), -np.inf)
+            np.testing.assert_allclose(block.lower[rows], bound, atol=1e-12)
+            row += len(held)
+        assert row == constraint.rows
