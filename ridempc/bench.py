@@ -32,9 +32,9 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    ticks took 0.63 ms median in each of three passes and p99 1.07, 0.80 and 1.14 ms, but
    the slowest 30 ticks of one pass were not those of the next (one in common), and each
    tick's fastest pass gave a p99 of 0.69 ms.
-4. **Other solvers.** The same WBC QPs (dense, a tick each) go to DAQP (the WBC's own
-   second solver) and to proxqp through qpsolvers, timed per call from a cold start
-   against OSQP's update-and-solve in its warm workspace, objectives compared with OSQP's.
+4. **Other solvers.** The same WBC QPs (dense, a tick each) go to the registry's other
+   solvers (OSQP in its warm workspace, proxqp from a cold start), objectives compared
+   with the loop solver's.
    The same MPC QPs, :math:`\\min \\tfrac12 z^\\top P z` s.t.
    :math:`l \\le A z \\le u`, are handed to each other backend available here: the
    qpsolvers backends (``proxqp``, ``daqp``, ... with equality rows :math:`l = u` as
@@ -42,10 +42,18 @@ For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIR
    layout, see :func:`_stage_layout`); each is timed from a cold start per problem (no
    warm start, only the solve call), and its objective compared with OSQP's.
 
-With ``wbc_solver="daqp"`` (``--wbc-solver daqp``) the whole-body QPs are solved by DAQP
-alone, in the ride (so its real-time factor and budget are DAQP's) and in step 3; step 4's
-WBC comparison, made against OSQP's warm workspace, is then left out. The product's solver
-stays OSQP: this measures the choice in the closed loop.
+The JSON's ``controller_tick_p99_ms`` is the p99 of the rider's whole update per control
+tick (estimator, MPC share, WBC and the rest), ``mpc_tick_p99_ms`` the MPC tick's (build
+and solve), ``controller_physics_ratio`` the rider's wall time over the simulation's in the
+same ride and ``reference_ms`` the machine reference. With ``profile`` (``--profile``) the
+pair rides once more under :class:`~ridempc.tickprofile.PartProfiler`, and ``profile``
+lists each part's hottest functions by their own time.
+
+The solvers are the registry's (:data:`ridempc.solvers.QP_KINDS`): the whole-body QPs
+are solved, in the ride and in step 3, by its solver (DAQP), or by ``wbc_solver``
+(``--wbc-solver osqp``: its real-time factor and budget are then OSQP's), and step 4
+compares the others on the same problems: OSQP in a warm workspace of its own, replaying
+them in order, the rest from a cold start.
 
 Times are wall-clock on this machine and vary with its load and its speed of the moment,
 which the budget table's **machine reference** records before each pair's ride
@@ -70,10 +78,11 @@ from ridempc.errors import RidempcError
 from ridempc.heap import frozen_heap
 from ridempc.interrupts import casadi_solve, osqp_returned
 from ridempc.io import atomic_write_json
+from ridempc.solvers import QP_KINDS, solve_dense
+from ridempc.tickprofile import DEFAULT_TOP, PartProfiler, profile_table
 
 __all__ = ["PairBench", "bench", "bench_table"]
 
-OTHER_QP_SOLVERS: tuple[str, ...] = ("proxqp", "daqp", "piqp", "clarabel")
 # Per pair, the scenario recorded: the skateboard's push-off (its two pushes, a foot
 # lifting and landing, are done by 4 s) and Cassie's first speed step (3-4 s).
 BENCH_SCENARIOS: dict[str, str] = {
@@ -91,7 +100,7 @@ class PairBench:
 
     pair: str
     scenario: str = ""
-    wbc_solver: str = "osqp"
+    wbc_solver: str = QP_KINDS["wbc"].solver
     mpc_problems: int = 0
     wbc_ticks: int = 0
     simulated_s: float = 0.0
@@ -100,6 +109,8 @@ class PairBench:
     mpc_solve_p99_ms: float = float("nan")
     mpc_tick_median_ms: float = float("nan")
     mpc_tick_p99_ms: float = float("nan")
+    controller_tick_p99_ms: float = float("nan")
+    controller_physics_ratio: float = float("nan")
     wbc_solve_median_ms: float = float("nan")
     wbc_solve_p99_ms: float = float("nan")
     mpc_solve_best_p99_ms: float = float("nan")
@@ -110,6 +121,7 @@ class PairBench:
     reference_ms: float = float("nan")
     solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
     wbc_solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
+    profile: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
 
 
 REFERENCE_ADDITIONS: int = 1_000_000  # the machine reference's loop (reference_ms)
@@ -187,8 +199,15 @@ def _timed(function: Callable[..., Any], spent: dict[str, float], key: str) -> C
 
 
 def _record(
-    robot_name: str, board_name: str, scenario_name: str, seconds: float, wbc_solver: str = "osqp"
+    robot_name: str,
+    board_name: str,
+    scenario_name: str,
+    seconds: float,
+    wbc_solver: str = QP_KINDS["wbc"].solver,
+    profiler: PartProfiler | None = None,
 ) -> tuple[Any, list, list, Any, dict[str, float]]:
+    """One ride of the pair's rider, its MPC problems and WBC inputs kept; with
+    ``profiler``, each part of its ticks (:data:`BUDGET_PARTS`) recorded into its own."""
     from ridempc.boards import load_board
     from ridempc.mpc.rider import MpcRider
     from ridempc.robots import load_robot
@@ -218,10 +237,33 @@ def _record(
     rider.estimator.update = _timed(  # type: ignore[method-assign]
         rider.estimator.update, parts, "estimator"
     )
+    if profiler is not None:
+        _profiled(rider, profiler)
     scenario = resolve_scenario(scenario_name, board_name).with_duration(seconds)
     scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=load_board(board_name))
-    result = Simulation(scene, rider, scenario).run()
+    simulation = Simulation(scene, rider, scenario)
+    if profiler is not None:
+        profiler.start()
+    try:
+        result = simulation.run()
+    finally:
+        if profiler is not None:
+            profiler.stop()
     return result, problems, wbc_inputs, rider, _budget(result, parts, rider.mpc_loop_seconds)
+
+
+def _profiled(rider: Any, profiler: PartProfiler) -> None:
+    """``rider``'s parts recorded each into its own profile (the simulation's is the
+    loop's, the rest of the rider's its update's; the MPC's its ticks and the waits for
+    their plans in the loop's thread)."""
+    for owner, method, part in (
+        (rider, "update", "rider_rest"),
+        (rider.estimator, "update", "estimator"),
+        (rider.wbc, "solve", "wbc"),
+        (rider, "_mpc_tick", "mpc"),
+        (rider, "_adopt_pending", "mpc"),
+    ):
+        setattr(owner, method, profiler.wrap(getattr(owner, method), part))
 
 
 def _as_qpsolvers(
@@ -249,15 +291,23 @@ def _objective(p: Any, z: np.ndarray, q: np.ndarray | None = None) -> float:
     return float(0.5 * z @ (p @ z) + (0.0 if q is None else q @ z))
 
 
-def _figures(times: Sequence[float], gaps: Sequence[float], failures: int) -> dict[str, Any]:
-    """One solver's row: solve times [s] as median and p99 [ms], failures, and the largest
-    objective gap to OSQP's (relative)."""
+def _figures(
+    times: Sequence[float],
+    gaps: Sequence[float],
+    failures: int,
+    first_input_diffs: Sequence[float] = (0.0,),
+) -> dict[str, Any]:
+    """One solver's row: solve times [s] as median and p99 [ms], failures, the largest
+    objective gap to the reference solver's (relative) and the largest difference in the
+    first input from the reference solver's (the MPC's :math:`u_0` in units of its
+    tolerances, the WBC's torques [N m])."""
     median, p99 = _stats(times)
     return {
         "solve_median_ms": median,
         "solve_p99_ms": p99,
         "failures": failures,
         "objective_gap_max": float(np.max(gaps)) if gaps else None,
+        "first_input_diff_max": float(np.max(first_input_diffs)) if first_input_diffs else None,
     }
 
 
@@ -275,19 +325,21 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
         lower, upper = qp.bounds(problem)
         data.append((p, a, lower, upper))
     layout = _stage_layout(qp.horizon, qp.nx, qp.nu, qp.n_constraints)
-    reference = []
+    reference, reference_u0 = [], []
+    first = slice((qp.horizon + 1) * qp.nx, (qp.horizon + 1) * qp.nx + qp.nu)  # u_0, scaled
     for p, a, lower, upper in data:
         qp_osqp = _as_qpsolvers(p, a, lower, upper)
         solution = qpsolvers.solve_problem(qp_osqp, solver="osqp", eps_abs=1e-6, eps_rel=1e-6)
         osqp_returned(solution.extras["info"].status_val)  # (ridempc.interrupts)
         found = solution.found and solution.x is not None
         reference.append(_objective(p, solution.x) if found else float("nan"))  # type: ignore[arg-type]
-    for name in (*OTHER_QP_SOLVERS, "hpipm (casadi)"):
+        reference_u0.append(solution.x[first] if found else None)  # type: ignore[index]
+    for name in QP_KINDS["mpc"].compared:
         if name != "hpipm (casadi)" and name not in qpsolvers.available_solvers:
             continue
-        times, gaps, failures = [], [], 0
+        times, gaps, failures, diffs = [], [], 0, []
         try:
-            for (p, a, lower, upper), best in zip(data, reference, strict=True):
+            for (p, a, lower, upper), best, u0 in zip(data, reference, reference_u0, strict=True):
                 if name == "hpipm (casadi)":
                     z, seconds = _solve_hpipm(p, a, lower, upper, layout)
                 else:
@@ -301,7 +353,9 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
                     failures += 1
                 else:
                     gaps.append(_gap(_objective(p, z), best))
-            out[name] = _figures(times, gaps, failures)
+                    if u0 is not None:
+                        diffs.append(float(np.max(np.abs(z[first] - u0))))
+            out[name] = _figures(times, gaps, failures, diffs)
         except Exception as exc:  # a backend's own error: reported, not fatal
             message = " ".join(f"{type(exc).__name__}: {exc}".split())
             out[name] = {"error": message[:160]}
@@ -457,10 +511,13 @@ def bench_pair(
     board: str,
     seconds: float = DEFAULT_SECONDS,
     scenario: str | None = None,
-    wbc_solver: str = "osqp",
+    wbc_solver: str = QP_KINDS["wbc"].solver,
+    profile: bool = False,
 ) -> PairBench:
     """Record one pair's ride and time its problems (see the module docstring), with
-    ``wbc_solver`` solving the whole-body QPs in the ride and in their timing."""
+    ``wbc_solver`` solving the whole-body QPs in the ride and in their timing; with
+    ``profile``, ride again under :class:`~ridempc.tickprofile.PartProfiler` for the
+    hottest functions of each part of the tick."""
     from ridempc.mpc.controller import LinearMpc
 
     name = f"{robot}-{board}"
@@ -476,6 +533,12 @@ def bench_pair(
     out.real_time_factor = float(result.sim_time / loop) if loop > 0 else float("nan")
     out.mpc_problems, out.wbc_ticks = len(problems), len(wbc_inputs)
     out.mpc_tick_median_ms, out.mpc_tick_p99_ms = _stats([1e-3 * ms for ms in rider.mpc_tick_ms])
+    out.controller_tick_p99_ms = _stats(result.controller_times.tolist())[1]
+    out.controller_physics_ratio = _controller_physics_ratio(result)
+    if profile:
+        profiler = PartProfiler(BUDGET_PARTS)
+        profiled = _record(robot, board, out.scenario, seconds, wbc_solver, profiler)[0]
+        out.profile = profiler.hottest(len(profiled.controller_times), DEFAULT_TOP)
     if problems:
         mpc = LinearMpc(rider.pair, rider.mpc.reference, rider.mpc.model, rider.mpc.settings)
         times, qp = _mpc_pass(mpc, problems)
@@ -489,9 +552,16 @@ def bench_pair(
         passes = [times] + [_wbc_pass(rider, wbc_inputs)[0] for _ in range(PASSES - 1)]
         out.wbc_solve_median_ms, out.wbc_solve_p99_ms = _stats(times)
         out.wbc_solve_best_p99_ms = _best_p99(passes)
-        # the comparison is against OSQP's warm workspace: with DAQP in the loop, none
-        out.wbc_solvers = _other_wbc_solvers(solved) if wbc_solver == "osqp" else {}
+        out.wbc_solvers = _other_wbc_solvers(rider, solved, wbc_solver)
     return out
+
+
+def _controller_physics_ratio(result: Any) -> float:
+    """The rider's wall time over the simulation's (physics, sensors, firmware, log) in
+    the same ride [-]."""
+    rider = float(np.sum(result.controller_times))
+    physics = result.wall_time - rider
+    return rider / physics if physics > 0.0 else float("nan")
 
 
 def _best_p99(passes: Sequence[Sequence[float]]) -> float:
@@ -512,18 +582,24 @@ def _mpc_pass(mpc: Any, problems: list) -> tuple[list[float], Any]:
     return times, qp
 
 
-def _wbc_pass(rider: Any, inputs: list) -> tuple[list[float], list, int]:
-    """The recorded whole-body ticks solved in order by a fresh copy of the rider's WBC:
-    each tick's wall time [s], the solved QPs (problem, solution, OSQP's time [s]) and the
-    number of ticks that failed."""
+def _wbc_copy(rider: Any, solver: str | None = None) -> Any:
+    """A fresh copy of the rider's WBC (its settings, its rolling platforms), on
+    ``solver`` if given."""
+    from dataclasses import replace
+
     from ridempc.wbc import WholeBodyController
 
-    wbc = WholeBodyController(  # the rider's own: its settings, its rolling platforms
-        rider.robot,
-        rider.wbc.settings,
-        pinocchio=rider.pinocchio,
-        platforms=rider.wbc.platforms,
+    settings = rider.wbc.settings if solver is None else replace(rider.wbc.settings, solver=solver)
+    return WholeBodyController(
+        rider.robot, settings, pinocchio=rider.pinocchio, platforms=rider.wbc.platforms
     )
+
+
+def _wbc_pass(rider: Any, inputs: list) -> tuple[list[float], list, int]:
+    """The recorded whole-body ticks solved in order by a fresh copy of the rider's WBC:
+    each tick's wall time [s], the solved QPs (problem, solution, the QP's time [s]) and the
+    number of ticks that failed."""
+    wbc = _wbc_copy(rider)
     times, solved, failures = [], [], 0
     with frozen_heap():
         for state, targets in inputs:
@@ -539,43 +615,56 @@ def _wbc_pass(rider: Any, inputs: list) -> tuple[list[float], list, int]:
     return times, solved, failures
 
 
-def _other_wbc_solvers(solved: list) -> dict[str, dict[str, Any]]:
-    """OSQP's WBC solves against DAQP's and proxqp's on the same problems (module
-    docstring); ``solved`` holds (problem, OSQP's solution, OSQP's QP time [s])."""
+def _osqp_workspace(rider: Any, solved: list) -> tuple[list[float], list, int]:
+    """The solved QPs in order in a fresh copy of the rider's OSQP workspace (warm-started
+    from one to the next): each solve's time [s], its solution (None: failed), failures."""
+    qp = _wbc_copy(rider, "osqp").qp
+    times: list[float] = []
+    answers: list[np.ndarray | None] = []
+    failures = 0
+    with frozen_heap():
+        for problem, _, _ in solved:
+            try:
+                solution = qp.solve(problem)
+            except RidempcError:
+                failures += 1
+                answers.append(None)
+                continue
+            times.append(solution.solve_time)
+            answers.append(solution.x)
+    return times, answers, failures
+
+
+def _other_wbc_solvers(rider: Any, solved: list, in_loop: str) -> dict[str, dict[str, Any]]:
+    """The loop's WBC solves (``in_loop``'s) against the other solvers' on the same
+    problems (module docstring): OSQP in its warm workspace, the others from a cold start;
+    ``solved`` holds (problem, the loop solver's solution, its QP time [s])."""
     import qpsolvers
 
-    from ridempc.wbc.qp import solve_daqp
-
-    out = {"osqp": {**_figures([t for _, _, t in solved], [0.0], 0), "warm_started": True}}
-    for name in ("daqp", "proxqp"):
-        if name != "daqp" and name not in qpsolvers.available_solvers:
+    kind = QP_KINDS["wbc"]
+    torque = rider.wbc.qp.layout.torque
+    out = {in_loop: {**_figures([t for _, _, t in solved], [0.0], 0), "warm_started": False}}
+    for name in (*kind.solvers, *kind.compared):
+        installed = name in kind.solvers or name in qpsolvers.available_solvers
+        if name == in_loop or not installed:
             continue
-        times, gaps, failures = [], [], 0
-        for problem, x_osqp, _ in solved:
-            z: np.ndarray | None
-            if name == "daqp":
-                started = time.perf_counter()
-                z, flag, _, _ = solve_daqp(problem)
-                times.append(time.perf_counter() - started)
-                z = z if flag >= 1 else None
-            else:
-                qp = _as_qpsolvers(
-                    sp.csc_matrix(problem.P),
-                    sp.csc_matrix(problem.A),
-                    problem.l,
-                    problem.u,
-                    problem.q,
-                )
-                started = time.perf_counter()
-                solution = qpsolvers.solve_problem(qp, solver=name)
-                times.append(time.perf_counter() - started)
-                z = solution.x if solution.found else None
-            if z is None:
-                failures += 1
-            else:
-                best = _objective(problem.P, x_osqp, problem.q)
-                gaps.append(_gap(_objective(problem.P, z, problem.q), best))
-        out[name] = _figures(times, gaps, failures)
+        times: list[float] = []
+        answers: list[np.ndarray | None] = []
+        failures = 0
+        if name == "osqp":
+            times, answers, failures = _osqp_workspace(rider, solved)
+        else:
+            for problem, _, _ in solved:
+                answer = solve_dense(name, problem)
+                times.append(answer.seconds)
+                answers.append(answer.x)
+                failures += int(answer.x is None)
+        pairs = [(p, x, z) for (p, x, _), z in zip(solved, answers, strict=True) if z is not None]
+        gaps = [_gap(_objective(p.P, z, p.q), _objective(p.P, x, p.q)) for p, x, z in pairs]
+        diffs = [float(np.max(np.abs(z[torque] - x[torque]))) for _, x, z in pairs]
+        figures = _figures(times, gaps, failures, diffs)
+        out[name] = {**figures, "warm_started": name == "osqp"}
+    out[in_loop]["warm_started"] = in_loop == "osqp"
     return out
 
 
@@ -590,8 +679,9 @@ def bench_table(rows: Sequence[PairBench]) -> str:
     lines = [
         "| pair | scenario | ride | MPC problems | MPC QP median / p99 / best p99 [ms] | "
         "MPC tick in the ride median / p99 [ms] | WBC ticks (failed) | "
-        "WBC (solver) median / p99 / best p99 [ms] | real-time factor |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "WBC (solver) median / p99 / best p99 [ms] | controller tick p99 [ms] | "
+        "controller / physics | real-time factor |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         mpc = (r.mpc_solve_median_ms, r.mpc_solve_p99_ms, r.mpc_solve_best_p99_ms)
@@ -602,11 +692,15 @@ def bench_table(rows: Sequence[PairBench]) -> str:
             f"{_ms(r.mpc_tick_median_ms)} / {_ms(r.mpc_tick_p99_ms)} | "
             f"{r.wbc_ticks} ({r.wbc_failures}) | "
             f"({r.wbc_solver}) {' / '.join(map(_ms, wbc))} | "
+            f"{_ms(r.controller_tick_p99_ms)} | {_ms(r.controller_physics_ratio)} | "
             f"{_ms(r.real_time_factor)} |"
         )
     lines += _budget_table(rows)
     for what, table in (("MPC", "solvers"), ("WBC", "wbc_solvers")):
         lines += _solver_table(what, [(r.pair, getattr(r, table)) for r in rows])
+    profiled = [(r.pair, r.profile) for r in rows if r.profile]
+    if profiled:
+        lines += profile_table(profiled)
     return "\n".join(lines)
 
 
@@ -626,18 +720,25 @@ def _budget_table(rows: Sequence[PairBench]) -> list[str]:
 
 
 def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]]]) -> list[str]:
-    """One solver table: per pair and solver, median / p99 [ms], failures, largest gap."""
-    lines = ["", f"| pair | {what} QP solver | median / p99 [ms] | failures | max objective gap |"]
-    lines.append("|---|---|---|---|---|")
+    """One solver table: per pair and solver, median / p99 [ms], failures, largest
+    objective gap and largest difference in the first input (:func:`_figures`)."""
+    unit = "u_0 [tolerances]" if what == "MPC" else "torque [N m]"
+    lines = [
+        "",
+        f"| pair | {what} QP solver | median / p99 [ms] | failures | max objective gap | "
+        f"max first-input difference, {unit} |",
+    ]
+    lines.append("|---|---|---|---|---|---|")
     for pair, solvers in rows:
         for name, s in solvers.items():
             if "error" in s:
-                lines.append(f"| {pair} | {name} | {s['error']} | - | - |")
+                lines.append(f"| {pair} | {name} | {s['error']} | - | - | - |")
                 continue
-            gap = s["objective_gap_max"]
+            gap, diff = s["objective_gap_max"], s.get("first_input_diff_max")
             lines.append(
                 f"| {pair} | {name} | {_ms(s['solve_median_ms'])} / {_ms(s['solve_p99_ms'])} | "
-                f"{s['failures']} | {'-' if gap is None else f'{gap:.1e}'} |"
+                f"{s['failures']} | {'-' if gap is None else f'{gap:.1e}'} | "
+                f"{'-' if diff is None else f'{diff:.1e}'} |"
             )
     return lines
 
@@ -647,11 +748,13 @@ def bench(
     seconds: float = DEFAULT_SECONDS,
     json_path: Path | None = None,
     scenario: str | None = None,
-    wbc_solver: str = "osqp",
+    wbc_solver: str | None = None,
+    profile: bool = False,
 ) -> list[PairBench]:
     """Benchmark ``pairs`` (default: every pair with an MPC) on their
     :data:`BENCH_SCENARIOS` (or ``scenario`` for all), with ``wbc_solver`` in the
-    whole-body QP, print and optionally save.
+    whole-body QP, print and optionally save; with ``profile``, each pair's hottest
+    functions per part of the tick too.
 
     Raises:
         UnknownNameError: A pair without an MPC, an unknown scenario or an unknown
@@ -662,10 +765,11 @@ def bench(
 
     from ridempc.errors import UnknownNameError
     from ridempc.mpc.pairs import MPC_PAIRS
-    from ridempc.wbc.settings import SOLVERS
 
-    if wbc_solver not in SOLVERS:
-        raise UnknownNameError("whole-body QP solver", wbc_solver, SOLVERS)
+    kind = QP_KINDS["wbc"]
+    wbc_solver = kind.solver if wbc_solver is None else wbc_solver
+    if wbc_solver not in kind.solvers:
+        raise UnknownNameError("whole-body QP solver", wbc_solver, kind.solvers)
     names = list(pairs) if pairs else list(MPC_PAIRS)
     for name in names:
         if name not in MPC_PAIRS:
@@ -679,7 +783,7 @@ def bench(
     for name in names:
         robot, board = name.split("-", 1)
         print(f"  {name}: recording {seconds:g} s of {recorded[name]} ...", flush=True)
-        rows.append(bench_pair(robot, board, seconds, recorded[name], wbc_solver))
+        rows.append(bench_pair(robot, board, seconds, recorded[name], wbc_solver, profile))
     print(bench_table(rows))
     if json_path is not None:
 

@@ -119,8 +119,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     bench.add_argument(
         "--wbc-solver",
-        default="osqp",
-        help="the whole-body QP's solver in the ride and its timing: osqp (default) or daqp",
+        default=None,
+        help="the whole-body QP's solver in the ride and its timing: daqp (default) or osqp",
+    )
+    bench.add_argument(
+        "--profile",
+        action="store_true",
+        help="ride each pair again under cProfile: the hottest functions of each part of the tick",
     )
     bench.add_argument(
         "--json", type=options.path, default=None, help="also write the results here"
@@ -220,6 +225,7 @@ def _bench(args: argparse.Namespace) -> int:
         json_path=args.json,
         scenario=args.scenario,
         wbc_solver=args.wbc_solver,
+        profile=args.profile,
     )
     return 0
 

@@ -88,14 +88,16 @@ def test_bad_input_is_refused(capsys) -> None:
     assert "whole-body QP solver 'qpoases' (valid: daqp, osqp)" in capsys.readouterr().err
 
 
-def test_the_closed_loop_can_ride_on_daqp() -> None:
-    """``--wbc-solver daqp``: the ride's whole-body QPs and their timing go to DAQP alone,
-    the ride stays up, and no comparison against OSQP's workspace is made."""
+def test_the_closed_loop_can_ride_on_osqp() -> None:
+    """``--wbc-solver osqp``: the ride's whole-body QPs and their timing go to OSQP (the
+    registry's DAQP then compared with it), and the ride stays up."""
     from ridempc.bench import bench_pair
 
-    out = bench_pair("cassie", "segway", seconds=0.2, wbc_solver="daqp")
+    out = bench_pair("cassie", "segway", seconds=0.2, wbc_solver="osqp")
     assert out.ride_status == "ok" and out.wbc_ticks == 100 and out.wbc_failures == 0
-    assert out.wbc_solver == "daqp" and out.wbc_solvers == {}
+    assert out.wbc_solver == "osqp" and out.wbc_solvers["osqp"]["warm_started"]
+    assert out.wbc_solvers["daqp"]["failures"] == 0
+    assert out.wbc_solvers["daqp"]["first_input_diff_max"] < 1e-3  # [N m]
     assert out.wbc_solve_median_ms > 0.0 and out.real_time_factor > 0.0
 
 

@@ -62,7 +62,10 @@ N_CONFIGURATIONS = 4
 # What holds each robot up in closed loop: Cassie's leaf springs are taken as rigid, because
 # MuJoCo's soft achilles-rod connect stretches under load and the rigidly closed heel-spring
 # estimate is then twice the true deflection (see ridempc.wbc.constraints.RigidSpringConstraint).
-CLOSED_LOOP_SETTINGS = {"cyberdog2": WbcSettings(), "cassie": WbcSettings(springs="rigid")}
+CLOSED_LOOP_SETTINGS = {  # on OSQP: its statuses and its workspace are what they check
+    "cyberdog2": WbcSettings(solver="osqp"),
+    "cassie": WbcSettings(springs="rigid", solver="osqp"),
+}
 
 
 def _quaternion_wxyz(q: np.ndarray) -> np.ndarray:
@@ -145,7 +148,7 @@ def _contact_cases(feet: int) -> list[np.ndarray]:
 
 @pytest.mark.parametrize("springs", ["passive", "rigid"])
 def test_solution_obeys_dynamics_contacts_friction_and_limits(robot, springs: Springs) -> None:
-    settings = WbcSettings(springs=springs)
+    settings = WbcSettings(springs=springs, solver="osqp")
     wbc = WholeBodyController(robot, settings)
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     layout = wbc.model.layout
@@ -334,7 +337,7 @@ REFERENCE_SETTINGS: dict[str, dict[str, Any]] = {
     "solver", [s for s in REFERENCE_SETTINGS if s in qpsolvers.available_solvers]
 )
 def test_persistent_workspace_matches_a_fresh_solve(robot, solver: str) -> None:
-    wbc = WholeBodyController(robot)
+    wbc = WholeBodyController(robot, WbcSettings(solver="osqp"))
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     rng = np.random.default_rng(7)
     for contact in _contact_cases(len(wbc.foot_names))[:2]:
@@ -400,7 +403,7 @@ def test_workspace_driven_directly_matches_osqps_public_methods() -> None:
 def test_daqp_as_the_solver_finds_osqps_polished_optimum(robot) -> None:
     """``WbcSettings(solver="daqp")``: each problem straight to DAQP (no OSQP workspace),
     the same optimum as OSQP's polished one; an unknown solver is refused by name."""
-    osqp_wbc = WholeBodyController(robot)
+    osqp_wbc = WholeBodyController(robot, WbcSettings(solver="osqp"))
     daqp_wbc = WholeBodyController(robot, WbcSettings(solver="daqp"))
     estimator = StateEstimator(robot, pinocchio=osqp_wbc.model.pinocchio)
     q, v = _standing(robot, estimator, np.random.default_rng(9))
@@ -431,7 +434,8 @@ def test_daqp_as_the_solver_fails_with_its_own_flag() -> None:
 def test_infeasible_qp_is_retried_cold_then_by_daqp_then_raises_wbc_failed() -> None:
     robot = load_robot("cyberdog2")
     # 2 kN on every foot cannot be held with 12 N m motors
-    wbc = WholeBodyController(robot, WbcSettings(min_normal_force=2000.0, max_normal_force=100))
+    settings = WbcSettings(min_normal_force=2000.0, max_normal_force=100, solver="osqp")
+    wbc = WholeBodyController(robot, settings)
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     q, v = _standing(robot, estimator, np.random.default_rng(3))
     wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.zeros(4, dtype=bool)))  # in flight: fine
@@ -450,7 +454,7 @@ def test_a_qp_osqp_cannot_solve_goes_to_daqp() -> None:
     problem exactly: the tight OSQP optimum, every row within its bounds."""
     robot = load_robot("cyberdog2")
     short = {**DEFAULT_OSQP_SETTINGS, "max_iter": 3, "check_termination": 1}
-    wbc = WholeBodyController(robot, WbcSettings(osqp=short))
+    wbc = WholeBodyController(robot, WbcSettings(osqp=short, solver="osqp"))
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     q, v = _standing(robot, estimator, np.random.default_rng(5))
     state, targets = _state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool))
@@ -459,7 +463,8 @@ def test_a_qp_osqp_cannot_solve_goes_to_daqp() -> None:
     problem = wbc.last_problem
     assert problem is not None
     tight = {**DEFAULT_OSQP_SETTINGS, "eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 100000}
-    reference = WholeBodyController(robot, WbcSettings(osqp=tight)).qp.solve(problem).x
+    tight_wbc = WholeBodyController(robot, WbcSettings(osqp=tight, solver="osqp"))
+    reference = tight_wbc.qp.solve(problem).x
     x = wbc.last_solution.x
     assert _cost(problem, x) == pytest.approx(_cost(problem, reference), rel=1e-6, abs=1e-8)
     ax = problem.A @ x

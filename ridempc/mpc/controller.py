@@ -36,11 +36,13 @@ from ridempc.mpc.qp import MpcQP, QPStructure
 from ridempc.mpc.reference import MotionReference, select_reference, steady_riding
 from ridempc.mpc.statics import StaticShift, static_shift
 from ridempc.mpc.weights import bryson_weights
+from ridempc.solvers import solver_for
 from ridempc.trajopt.schedule import Contact
 
 __all__ = ["LinearMpc", "MpcSettings"]
 
 Array = NDArray[np.float64]
+_QP_BACKENDS: dict[str, type[MpcQP]] = {"osqp": MpcQP}  # the MPC's QP, by solver name
 
 
 @dataclass(frozen=True)
@@ -288,9 +290,11 @@ class LinearMpc:
         return shift
 
     def build_qp(self, problem: MpcProblem, **osqp: float | int | bool) -> MpcQP:
-        """A QP for this MPC's problems: the pair's fixed pattern, scaled by the weights'
-        tolerances, OSQP set up with ``settings.osqp`` and ``osqp`` over the defaults."""
-        return MpcQP(
+        """A QP for this MPC's problems on the registry's solver
+        (:data:`~ridempc.solvers.QP_KINDS`, OSQP): the pair's fixed pattern, scaled by the
+        weights' tolerances, OSQP set up with ``settings.osqp`` and ``osqp`` over the
+        defaults."""
+        return _QP_BACKENDS[solver_for("mpc")](
             problem,
             self.structure,
             state_scale=_tolerance(self.state_weights),

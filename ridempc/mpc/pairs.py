@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from functools import cache, partial
+from functools import cache, lru_cache, partial
 from types import MappingProxyType
 from typing import NamedTuple
 
@@ -24,6 +24,8 @@ from numpy.typing import NDArray
 from ridempc.boards import load_board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.errors import UnknownNameError
+from ridempc.mpc.buffered import BufferedFunction
+from ridempc.mpc.codegen import compiled
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.settle import settle_over_feet
 from ridempc.trajopt.pairs import Pair, load_pair
@@ -190,9 +192,17 @@ class MpcPair(NamedTuple):
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
-    """Per contact, the surface rotation at the state ``x0``, n_c x 3 x 3."""
-    stacked = np.asarray(pair.surfaces(np.asarray(x0, dtype=float)))
+    """Per contact, the surface rotation at the state ``x0``, n_c x 3 x 3 (the pair's
+    ``surfaces`` compiled and called through NumPy buffers, :func:`_buffered`)."""
+    (stacked,) = _buffered(pair.surfaces)(np.asarray(x0, dtype=float))
     return stacked.reshape(3, -1, 3).transpose(1, 0, 2)
+
+
+@lru_cache(maxsize=8)
+def _buffered(function: ca.Function) -> BufferedFunction:
+    """``function`` compiled (:func:`~ridempc.mpc.codegen.compiled`) and buffered, once
+    per function."""
+    return BufferedFunction(compiled(function))
 
 
 def _skateboard() -> MpcPair:

@@ -45,6 +45,7 @@ would still be approximate.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import NamedTuple
@@ -53,6 +54,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.mpc.buffered import BufferedFunction
+from ridempc.mpc.codegen import compiled
 from ridempc.mpc.discretisation import zero_order_hold
 from ridempc.trajopt.schedule import Contact
 
@@ -111,32 +114,27 @@ class LinearModel:
 
     def evaluate(self, x0: Array, u_ref: Array, p_k: Array) -> tuple[Array, Array, Array]:
         """:attr:`jacobians` at :math:`(\\hat x_0, \\bar u_k, p_k)` for every step, in one
-        call of a mapped function built once per horizon.
+        call of a mapped function built once per horizon (compiled to C and cached,
+        :func:`~ridempc.mpc.codegen.compiled`).
 
         Returns:
             :math:`f_k` (N x nx), :math:`A^c_k` (N x nx x nx), :math:`B^c_k` (N x nx x nu).
         """
         horizon = len(u_ref)
         if horizon not in self._mapped:
-            self._mapped[horizon] = _MappedJacobians(self.jacobians.map(horizon), horizon)
+            mapped = compiled(self.jacobians.map(horizon))  # C where a compiler is found
+            self._mapped[horizon] = _MappedJacobians(mapped, horizon)
         return self._mapped[horizon](x0, u_ref, p_k)
 
 
 class _MappedJacobians:
-    """A mapped Jacobian function evaluated into NumPy buffers (CasADi's ``buffer``), its
-    sparse outputs scattered into dense stacks: converting CasADi matrices to NumPy costs
-    more than evaluating them."""
+    """A mapped Jacobian function evaluated into NumPy buffers
+    (:class:`~ridempc.mpc.buffered.BufferedFunction`), its sparse outputs scattered into
+    dense stacks: converting CasADi matrices to NumPy costs more than evaluating them."""
 
     def __init__(self, function: ca.Function, horizon: int) -> None:
         self.function, self.horizon = function, horizon
-        self.buffer, self.run = function.buffer()
-        self.args = [np.zeros(function.nnz_in(i)) for i in range(3)]
-        self.results = [np.zeros(function.nnz_out(i)) for i in range(3)]
-        # CasADi's stubs list a size argument its SWIG wrapper takes from the buffer itself.
-        for i, array in enumerate(self.args):
-            self.buffer.set_arg(i, memoryview(array))  # type: ignore[call-arg, arg-type]
-        for i, array in enumerate(self.results):
-            self.buffer.set_res(i, memoryview(array))  # type: ignore[call-arg, arg-type]
+        self.buffered = BufferedFunction(function)
         self.scatter = []
         for i in (1, 2):  # columns j + k n of step k, nonzeros in column-major order
             rows, cols = (
@@ -146,14 +144,11 @@ class _MappedJacobians:
             self.scatter.append((cols // n, rows, cols % n, n))
 
     def __call__(self, x0: Array, u_ref: Array, p_k: Array) -> tuple[Array, Array, Array]:
-        self.args[0][:] = np.tile(x0, self.horizon)
-        self.args[1][:] = u_ref.ravel()
-        self.args[2][:] = p_k.ravel()
-        self.run()
+        results = self.buffered.nonzeros(np.tile(x0, self.horizon), u_ref.ravel(), p_k.ravel())
         nx = len(x0)
-        rates = self.results[0].reshape(self.horizon, nx).copy()
+        rates = results[0].reshape(self.horizon, nx).copy()
         dense = []
-        for (k, i, j, n), values in zip(self.scatter, self.results[1:], strict=True):
+        for (k, i, j, n), values in zip(self.scatter, results[1:], strict=True):
             out = np.zeros((self.horizon, nx, n))
             out[k, i, j] = values
             dense.append(out)
@@ -353,18 +348,19 @@ class MpcProblem:
         }
         bounds = ("input_lower", "input_upper", "constraint_lower", "constraint_upper")
         for name, value in checked.items():
-            if name not in bounds and not np.all(np.isfinite(value)):
+            # a sum is NaN or infinite when an entry is: one reduction, not an array of flags
+            if name not in bounds and not math.isfinite(value.sum()):
                 raise ValueError(f"MpcProblem: {name} holds NaN or infinite values")
-            if name in bounds and np.any(np.isnan(value)):
+            if name in bounds and np.isnan(value).any():
                 raise ValueError(f"MpcProblem: {name} holds NaN")
             object.__setattr__(self, name, value)
         for name in ("state_weights", "input_weights", "terminal_weights"):
-            if np.any(checked[name] < 0.0):
+            if checked[name].min() < 0.0:
                 raise ValueError(f"MpcProblem: {name} must be non-negative")
         for low, high in (("input_lower", "input_upper"), ("constraint_lower", "constraint_upper")):
-            bad = np.argwhere(checked[low] > checked[high])
-            if len(bad):
-                k, i = bad[0]
+            above = checked[low] > checked[high]
+            if above.any():
+                k, i = np.argwhere(above)[0]
                 raise ValueError(
                     f"MpcProblem: {low}[{k}, {i}] = {checked[low][k, i]:g} is above "
                     f"{high}[{k}, {i}] = {checked[high][k, i]:g}"

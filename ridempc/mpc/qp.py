@@ -205,6 +205,15 @@ class MpcQP:
             [np.tile(sx, n + 1), np.tile(su, n), np.ones(n * self.n_constraints)]
         )
         self._input_scale = su
+        s = self.structure
+        self._outside_at = {
+            name: np.flatnonzero(~pattern)
+            for name, pattern in (
+                ("A", s.state_pattern),
+                ("B", s.input_pattern),
+                ("constraint_matrix", s.constraint_pattern),
+            )
+        }
         self._build_pattern()
         hessian, csc = self.matrices(problem)
         _, lower, upper = self._data(problem)
@@ -298,8 +307,14 @@ class MpcQP:
         )
 
     def _outside(self, name: str, values: Array, pattern: BoolArray) -> None:
+        outside = self._outside_at[name]  # flat indices of the entries off the pattern
+        if not outside.size:
+            return
+        largest = float(np.abs(values.reshape(len(values), -1).take(outside, axis=1)).max())
+        if largest <= _PATTERN_TOLERANCE:  # below the bound whatever the matrix's scale
+            return
         stray = np.abs(values[:, ~pattern])
-        if stray.size and stray.max() > _PATTERN_TOLERANCE * max(1.0, np.abs(values).max()):
+        if stray.max() > _PATTERN_TOLERANCE * max(1.0, np.abs(values).max()):
             raise ValueError(
                 f"MpcQP: {name} has a non-zero outside the QP's fixed pattern "
                 f"(largest {stray.max():.3g}); build the QP with a QPStructure covering it"

@@ -119,6 +119,7 @@ from ridempc.scenarios.scenario import Command
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
+from ridempc.solvers import solver_for
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skateboard import skateboard_model
@@ -208,8 +209,8 @@ class MpcRider(Controller):
         robot: The rider.
         board: The board's name; the pair needs an MPC library.
         settings: MPC settings.
-        wbc_solver: The whole-body QP's solver (:data:`~ridempc.wbc.settings.SOLVERS`):
-            ``osqp``, the product's, or ``daqp`` to measure the choice.
+        wbc_solver: The whole-body QP's solver (:data:`~ridempc.wbc.settings.SOLVERS`);
+            None: the registry's (:data:`~ridempc.solvers.QP_KINDS`).
 
     Raises:
         UnknownNameError: No MPC for this robot-board pair.
@@ -223,7 +224,7 @@ class MpcRider(Controller):
         robot: Robot,
         board: str,
         settings: MpcSettings | None = None,
-        wbc_solver: str = "osqp",
+        wbc_solver: str | None = None,
         plan_latency: int | None = None,
     ) -> None:
         super().__init__(robot, board)
@@ -288,7 +289,7 @@ class MpcRider(Controller):
             springs="rigid" if sprung else "passive",
             force_weight=robot.params.wbc_force_weight,
             pyramid=self.pair.pyramid,
-            solver=wbc_solver,
+            solver=wbc_solver or solver_for("wbc"),
         )
         self.wbc = WholeBodyController(
             robot,

@@ -191,14 +191,20 @@ class StateMap:
         self._rates = {}
         self._heading_time = 0.0
 
-    def _board_value(self, key: str, boards: tuple[BoardEstimate, ...], time: float) -> float:
+    def _board_value(
+        self, key: str, boards: tuple[BoardEstimate, ...], time: float, origins: dict[int, Array]
+    ) -> float:
+        """One board state of ``key`` (``platform:field``); ``origins`` holds each
+        platform's position in the library frame once found (one per :meth:`state`)."""
         index, field = key.split(":", 1)
         k = int(index)
         if k >= len(boards):
             raise ConfigError(f"MPC state map: no estimate of platform {k}")
         board = boards[k]
         heading = board.yaw - self.frame.yaw
-        origin = self.frame.point_to_library(board.position)
+        if k not in origins:
+            origins[k] = self.frame.point_to_library(board.position)
+        origin = origins[k]
         if field == "x":
             return float(origin[0])
         if field == "y":
@@ -234,6 +240,7 @@ class StateMap:
         com_lib = self.frame.point_to_library(com)
         velocity_lib = self.frame.vector_to_library(com_velocity)
         x = np.empty(len(self.names))
+        origins: dict[int, Array] = {}
         for i, (kind, key) in enumerate(self._fill):
             if kind == "com":
                 x[i] = com_lib[int(key)]
@@ -246,7 +253,7 @@ class StateMap:
             elif kind == "joint":
                 x[i] = estimate.joint_position[str(key)]
             else:
-                x[i] = self._board_value(str(key), estimate.boards, estimate.time)
+                x[i] = self._board_value(str(key), estimate.boards, estimate.time, origins)
         return x
 
     def com(self, estimate: EstimatedState) -> Array:

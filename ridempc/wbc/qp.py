@@ -41,12 +41,12 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-import daqp
 import numpy as np
 import scipy.sparse as sparse
 from numpy.typing import NDArray
 
 from ridempc.errors import RidempcError
+from ridempc.solvers import solve_daqp, solve_dense, solver_for
 from ridempc.wbc.constraints import Constraint, LinearConstraint
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
@@ -61,7 +61,6 @@ __all__ = ["QpProblem", "QpSolution", "WbcFailed", "WholeBodyQP", "solve_daqp"]
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 ACCEPTED: frozenset[str] = frozenset({"solved", "solved inaccurate"})
-DAQP_INFINITY: float = 1e30  # DAQP's bound for a free row
 PATTERN_TOLERANCE: float = 1e-12  # [-] entries dropped from the pattern, over the largest
 
 
@@ -116,33 +115,6 @@ class QpSolution:
 def _violation(problem: QpProblem, ax: Array) -> float:
     """Largest distance of :math:`A z` outside :math:`[l, u]`."""
     return float(np.max(np.maximum(ax - problem.u, problem.l - ax), initial=0.0))
-
-
-def solve_daqp(problem: QpProblem) -> tuple[Array, int, int, Array]:
-    """DAQP on the dense problem, rows with :math:`l = u` as equalities.
-
-    Returns:
-        The solution, DAQP's exit flag (1 or more: solved), its iterations and the row
-        multipliers.
-    """
-    equal = problem.l == problem.u
-    sense = np.where(equal, 5, 0).astype(np.int32)  # 5: an equality (active, immutable)
-    upper = np.where(np.isfinite(problem.u), problem.u, DAQP_INFINITY)
-    lower = np.where(np.isfinite(problem.l), problem.l, -DAQP_INFINITY)
-    x, _, flag, info = daqp.solve(
-        np.ascontiguousarray(problem.P, dtype=float),
-        np.array(problem.q, dtype=float),
-        np.ascontiguousarray(problem.A, dtype=float),
-        upper,
-        lower,
-        sense,
-    )
-    return (
-        np.asarray(x, dtype=float),
-        int(flag),
-        int(info["iterations"]),
-        np.asarray(info["lam"], dtype=float),
-    )
 
 
 class WbcFailed(RidempcError, RuntimeError):
@@ -205,8 +177,9 @@ class WholeBodyQP:
         tasks: The objective's terms.
         constraints: The constraint blocks.
         settings: OSQP settings (``DEFAULT_OSQP_SETTINGS`` where not given).
-        solver: ``osqp`` (module docstring), or ``daqp``: each problem straight to DAQP,
-            no OSQP workspace (:data:`~ridempc.wbc.settings.SOLVERS`).
+        solver: ``osqp`` (module docstring), or a dense backend of
+            :func:`~ridempc.solvers.solve_dense` (``daqp``): each problem straight to it,
+            no OSQP workspace; None: the registry's (:data:`~ridempc.solvers.QP_KINDS`).
 
     Attributes:
         setups: OSQP workspace set-ups so far (one at the first solve, one more each time
@@ -222,10 +195,10 @@ class WholeBodyQP:
         tasks: Sequence[Task],
         constraints: Sequence[Constraint],
         settings: Mapping[str, float | int | bool] | None = None,
-        solver: str = "osqp",
+        solver: str | None = None,
     ) -> None:
         self.layout = layout
-        self.solver = solver
+        self.solver = solver_for("wbc", solver)
         self.tasks = tuple(tasks)
         self.constraints = tuple(c for c in constraints if c.rows > 0)
         self.settings = {**DEFAULT_OSQP_SETTINGS, **(settings or {})}
@@ -281,8 +254,8 @@ class WholeBodyQP:
                 and DAQP finds no solution either.
         """
         start = time.perf_counter()
-        if self.solver == "daqp":
-            return self._daqp(problem, start)
+        if self.solver != "osqp":
+            return self._dense(problem, start)
         solver = self._solver
         warm = solver is not None and self._fits(problem)
         if warm:
@@ -331,25 +304,27 @@ class WholeBodyQP:
         Raises:
             WbcFailed: DAQP finds no finite solution either (with OSQP's ``status``).
         """
-        solution = self._daqp(problem, start, status)
+        solution = self._dense(problem, start, status)
         self.fallbacks += 1
         return solution
 
-    def _daqp(self, problem: QpProblem, start: float, status: str | None = None) -> QpSolution:
-        """DAQP on the dense problem, as the solver or as OSQP's second (after OSQP's
-        ``status``).
+    def _dense(self, problem: QpProblem, start: float, status: str | None = None) -> QpSolution:
+        """The dense problem solved by the QP's dense backend (:attr:`solver`), or by DAQP
+        as OSQP's second (after OSQP's ``status``).
 
         Raises:
-            WbcFailed: DAQP finds no finite solution (with OSQP's ``status``, if any).
+            WbcFailed: It finds no finite solution (with OSQP's ``status``, if any).
         """
-        x, flag, iterations, duals = solve_daqp(problem)
-        if flag < 1 or not np.all(np.isfinite(x)):
-            raise WbcFailed(status, problem, daqp_flag=flag)
+        name = "daqp" if status is not None else self.solver
+        answer = solve_dense(name, problem)
+        if not answer.found or answer.x is None:
+            raise WbcFailed(status, problem, daqp_flag=answer.flag)
+        duals = answer.duals if answer.duals is not None else np.zeros(len(problem.l))
         solution = QpSolution(
-            x=x,
+            x=answer.x,
             y=duals,
-            status="solved by daqp",
-            iterations=iterations,
+            status=f"solved by {name}",
+            iterations=answer.iterations,
             polished=True,
             refined=False,
             solve_time=time.perf_counter() - start,

@@ -34,6 +34,7 @@ from typing import Literal
 
 from ridempc.errors import ConfigError
 from ridempc.friction import SHAPES
+from ridempc.solvers import QP_KINDS
 
 __all__ = ["DEFAULT_OSQP_SETTINGS", "SOLVERS", "TrackingGains", "WbcSettings"]
 
@@ -53,7 +54,7 @@ DEFAULT_OSQP_SETTINGS: MappingProxyType[str, float | int | bool] = MappingProxyT
 )
 
 
-SOLVERS: tuple[str, ...] = ("osqp", "daqp")  # the whole-body QP's solvers, by name
+SOLVERS: tuple[str, ...] = QP_KINDS["wbc"].solvers  # the whole-body QP's, by name
 
 
 @dataclass(frozen=True)
@@ -104,11 +105,10 @@ class WbcSettings:
         torque_regularisation: Weight of :math:`\\|\\tau\\|^2` [1/(N m)^2].
         loop_force_regularisation: Weight of :math:`\\|\\lambda\\|^2` [1/N^2].
         osqp: OSQP settings, over ``DEFAULT_OSQP_SETTINGS``.
-        solver: The QP's solver, by name (``SOLVERS``): ``osqp`` (ADMM, polished; DAQP
-            where it fails), the product's, or ``daqp`` (a dual active-set method, exact;
-            0.06 / 0.13 ms median / p99 on Cassie's Hovershoes QPs against OSQP's
-            0.32 / 0.51, ``ridempc bench``), to measure the choice in the closed loop
-            (``ridempc bench --wbc-solver``).
+        solver: The QP's solver, by name (``SOLVERS``): the registry's
+            (:data:`~ridempc.solvers.QP_KINDS`), ``daqp`` (a dual active-set method, exact),
+            or ``osqp`` (ADMM, polished; DAQP where it fails), to measure the choice in the
+            closed loop (``ridempc bench --wbc-solver``).
     """
 
     dt: float = 0.002
@@ -130,7 +130,7 @@ class WbcSettings:
     torque_regularisation: float = 1e-5
     loop_force_regularisation: float = 1e-8
     osqp: Mapping[str, float | int | bool] = field(default_factory=lambda: DEFAULT_OSQP_SETTINGS)
-    solver: str = "osqp"
+    solver: str = QP_KINDS["wbc"].solver
 
     def __post_init__(self) -> None:
         if self.dt <= 0.0:
