@@ -158,3 +158,18 @@ def test_contact_acceleration_rows_match_the_per_site_formula(model: WholeBodyMo
             np.testing.assert_allclose(block.lower[rows], bound, atol=1e-12)
             row += len(held)
         assert row == constraint.rows
+
+
+def test_foot_points_are_the_mean_of_their_sites(model: WholeBodyModel) -> None:
+    """Each foot's point, by one product with the feet's 0/1 sum, equals the sum of its
+    sites' positions over their count (the former ``bincount`` per axis), bit for bit."""
+    rng = np.random.default_rng(13)
+    data = model.model.createData()
+    feet = model.site_foot
+    for _ in range(20):
+        q, _ = _random_state(model, rng)
+        pin.framesForwardKinematics(model.model, data, q)
+        sites = np.array([data.oMf[f].translation for f in model.site_frames])
+        count = np.bincount(feet, minlength=len(model.foot_names))[:, None]
+        sums = [np.bincount(feet, sites[:, k], len(model.foot_names)) for k in range(3)]
+        np.testing.assert_array_equal(model.foot_points(q), np.stack(sums, 1) / count)

@@ -183,6 +183,11 @@ class WholeBodyModel:
         self._first_anchor_rows = slice(1 + n_sites, 1 + n_sites + n_loops)
         self._second_anchor_rows = slice(1 + n_sites + n_loops, 1 + n_sites + 2 * n_loops)
         self.site_partner, self.line_basis = self._line_feet()
+        # each foot's sites summed (a 0/1 matrix), and their count, for foot_points
+        feet = self.legs.site_foot
+        self._foot_sum = np.zeros((len(self.foot_names), len(feet)))
+        self._foot_sum[feet, np.arange(len(feet))] = 1.0
+        self._foot_count = np.bincount(feet, minlength=len(self.foot_names))[:, None]
 
     def _line_feet(self) -> tuple[Index, Array]:
         """For each site, the first site of its foot if it is a line foot's second one
@@ -248,12 +253,7 @@ class WholeBodyModel:
         model, data = self.model, self._points_data
         pin.framesForwardKinematics(model, data, np.asarray(q, dtype=float))
         sites = np.array([data.oMf[f].translation for f in self.site_frames])
-        feet = self.legs.site_foot
-        count = np.bincount(feet, minlength=len(self.foot_names))[:, None]
-        return np.asarray(
-            np.stack([np.bincount(feet, sites[:, k], len(self.foot_names)) for k in range(3)], 1)
-            / count
-        )
+        return np.asarray(self._foot_sum.dot(sites) / self._foot_count)
 
     def passive_torque(self, q: Array, v: Array) -> Array:
         """:math:`\\tau_p = -K (q - q_{ref}) - D v` [N m] (springs and joint damping)."""
