@@ -281,20 +281,19 @@ class WholeBodyModel:
             np.array(data.acom[0]),
         )
         frames = self._frames
-        count = len(frames)
-        positions = np.empty((count, 3))
-        rotations = np.empty((self._site_rows.stop, 3, 3))
-        jacobians = np.empty((count, 3, nv))
-        drifts = np.empty((count, 3))
-        placements = data.oMf
-        rotated = self._site_rows.stop  # the base and the sites
-        for k, frame in enumerate(frames):
-            placement = placements[frame]
-            positions[k] = placement.translation
-            if k < rotated:
-                rotations[k] = placement.rotation
-            jacobians[k] = pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3]
-            drifts[k] = pin.getFrameClassicalAcceleration(model, data, frame, WORLD_ALIGNED).linear
+        placements = [data.oMf[frame] for frame in frames]
+        positions = np.array([placement.translation for placement in placements])
+        # orientations of the base and the sites only (the anchors' are not read)
+        rotations = np.array([p.rotation for p in placements[: self._site_rows.stop]])
+        jacobians = np.array(
+            [pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3] for frame in frames]
+        )
+        drifts = np.array(
+            [
+                pin.getFrameClassicalAcceleration(model, data, frame, WORLD_ALIGNED).linear
+                for frame in frames
+            ]
+        )
         velocities = jacobians @ v
         sites, first, second = self._site_rows, self._first_anchor_rows, self._second_anchor_rows
         return ModelTerms(
