@@ -365,35 +365,33 @@ class PlatformTipConstraint(Constraint):
         self.rows = 2 * platforms
         self._lower = np.full(self.rows, -INF)
         self._upper = np.zeros(self.rows)
-        self._entries: dict[bytes, tuple[Index, Index, Index]] = {}
+        self._entries: dict[tuple[bytes, ...], tuple[Index, Index, Index]] = {}
 
-    def _indices(self, sites: Index, counts: list[int]) -> tuple[Index, Index, Index]:
-        """The rows (+ and -) and columns of each site's three force components, for the
-        platforms' sites in a row (``counts`` each; a few distinct lists per ride)."""
-        key = sites.tobytes() + bytes(counts)
+    def _indices(self, sites: tuple[Index, ...]) -> tuple[Index, Index, Index]:
+        """The platforms' sites in a row, and the flat indices (rows ``+`` and ``-``, in the
+        block's own matrix) of their three force components; a few distinct lists per ride."""
+        key = tuple(s.tobytes() for s in sites)
         cached = self._entries.get(key)
         if cached is None:
-            platform = np.repeat(np.arange(len(counts)), counts)
-            columns = (self.layout.force.start + 3 * sites[:, None] + np.arange(3)).ravel()
-            plus = np.repeat(2 * platform, 3)
-            cached = self._entries[key] = (plus, plus + 1, columns)
+            stacked = np.concatenate(sites)
+            platform = np.repeat(np.arange(len(sites)), [len(s) for s in sites])
+            columns = (self.layout.force.start + 3 * stacked[:, None] + np.arange(3)).ravel()
+            plus = np.repeat(2 * platform, 3) * self.layout.size + columns
+            cached = self._entries[key] = (stacked, plus, plus + self.layout.size)
         return cached
 
     def fill_qp_constraint(
         self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> None:
-        matrix = block.matrix
         tipping = contacts.tipping[: self.rows // 2]
         if tipping:
-            counts = [len(t[0]) for t in tipping]
-            sites = np.concatenate([t[0] for t in tipping])
-            plus, minus, columns = self._indices(sites, counts)
+            sites, plus, minus = self._indices(tuple(t[0] for t in tipping))
             offsets = np.concatenate([t[1] for t in tipping])[:, None]
             ratio = np.concatenate([t[2] for t in tipping])[:, None]
             axes = contacts.frame[sites]
             side, normal = axes[:, 1], axes[:, 2]
-            matrix[plus, columns] = ((offsets - ratio) * normal - side).ravel()
-            matrix[minus, columns] = ((-offsets - ratio) * normal + side).ravel()
+            block.matrix.put(plus, (offsets - ratio) * normal - side)
+            block.matrix.put(minus, (-offsets - ratio) * normal + side)
         block.lower[:] = self._lower
         block.upper[:] = self._upper
 
