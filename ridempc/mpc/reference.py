@@ -192,16 +192,21 @@ class MotionReference:
     def _settled(self, times: Array) -> Array:
         """How far the settle has gone at ``times``: :math:`3\\tau^2 - 2\\tau^3`,
         :math:`\\tau = (t - T) / t_{settle}` clipped to [0, 1]."""
-        tau = np.clip((times - self.times[-1]) / max(self.settle_time, 1e-9), 0.0, 1.0)
+        # np.minimum(np.maximum()): np.clip's wrapper costs some 5 us a call, three a tick
+        tau = np.minimum(
+            np.maximum((times - self.times[-1]) / max(self.settle_time, 1e-9), 0.0), 1.0
+        )
         return tau * tau * (3.0 - 2.0 * tau)
 
 
 def _interp_rows(t: Array, grid: Array, table: Array) -> Array:
     """:func:`numpy.interp` of every column of ``table`` (rows on the increasing ``grid``)
     at the times ``t``, held at the ends; one search for all columns."""
-    upper = np.clip(np.searchsorted(grid, t, side="right"), 1, len(grid) - 1)
+    # np.minimum(np.maximum()): np.clip's wrapper costs some 5 us a call, per tick
+    upper = np.minimum(np.maximum(np.searchsorted(grid, t, side="right"), 1), len(grid) - 1)
     lower = upper - 1
-    weight = np.clip((t - grid[lower]) / (grid[upper] - grid[lower]), 0.0, 1.0)[:, None]
+    fraction = (t - grid[lower]) / (grid[upper] - grid[lower])
+    weight = np.minimum(np.maximum(fraction, 0.0), 1.0)[:, None]
     return np.asarray((1.0 - weight) * table[lower] + weight * table[upper])
 
 

@@ -86,7 +86,6 @@ from ridempc.boards.skateboard.reduced import yaw_rate
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
-from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
@@ -102,6 +101,7 @@ from ridempc.mpc.manoeuvre import (
 )
 from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
+from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.qp import SolveOutcome, StartedSolve
 from ridempc.mpc.roll_observer import RollObserver
@@ -121,7 +121,6 @@ from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.solvers import solver_for
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
-from ridempc.trajopt.rotations import euler_zyx_matrix
 from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skateboard import skateboard_model
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
@@ -314,6 +313,15 @@ class MpcRider(Controller):
         )
         self.torque_lead = TorqueLead(robot, self.wbc.settings.dt)  # sent ahead of the delay
         self._contact_foot = self._contacts_to_feet(reference.contact_names)
+        self._read_plan = PlanReader(
+            self.layout.names,
+            self.layout.base_prefix,
+            reference.force_index,
+            self._contact_foot,
+            len(robot.params.foot_bodies),
+            self._feedforward,
+            self.mpc.settings.dt,
+        )
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
@@ -808,31 +816,8 @@ class MpcRider(Controller):
     def _wbc_tick(self, estimate: EstimatedState, now: float) -> MotorCommand:
         plan = self._plan
         assert plan is not None
-        n = self.layout.names
-        x = plan.first_step_state((now - self._plan_time) * 30.0)
+        wanted = self._read_plan(plan, self._plan_frame, (now - self._plan_time) * 30.0)
         frame = self._plan_frame
-        position = frame.point_to_world(np.array([x[n["com_x"]], x[n["com_y"]], x[n["com_z"]]]))
-        velocity = frame.vector_to_world(np.array([x[n["vx"]], x[n["vy"]], x[n["vz"]]]))
-        base = self.layout.base_prefix
-        roll, pitch, yaw = (x[n[f"{base}{a}"]] for a in ("roll", "pitch", "yaw"))
-        rotation = euler_zyx_matrix(roll, pitch, yaw + frame.yaw)
-        orientation = matrix_to_quaternion(rotation)
-        omega_body = np.array([x[n["wx"]], x[n["wy"]], x[n["wz"]]])
-        # The plan's accelerations over its first step, where the robot feeds them forward.
-        acceleration = angular_acceleration = np.zeros(3)
-        if self._feedforward:
-            step = self._feedforward * (plan.states[1] - plan.states[0]) / self.mpc.settings.dt
-            acceleration = frame.vector_to_world(np.array([step[n[k]] for k in ("vx", "vy", "vz")]))
-            angular_acceleration = rotation @ np.array([step[n[k]] for k in ("wx", "wy", "wz")])
-        index = self.mpc.reference.force_index
-        feet = len(self.robot.params.foot_bodies)
-        forces = np.zeros((feet, 3))
-        u = plan.first_input
-        site_forces = np.zeros((len(self._contact_foot), 3))
-        for i, foot in enumerate(self._contact_foot):
-            f = frame.vector_to_world(u[index[i]])
-            site_forces[i] = f
-            forces[foot] += f
         assert self._support is not None  # set by the MPC tick, which runs first
         contact = np.array([c is not Contact.SWING for c in self._support])
         swing = swing_velocity = posture = None
@@ -848,15 +833,15 @@ class MpcRider(Controller):
         if not contact.any():
             contact[:] = True
         targets = WbcTargets(
-            position=position,
-            orientation=orientation,
+            position=wanted.position,
+            orientation=wanted.orientation,
             contact=contact,
-            forces=forces,
-            velocity=velocity,
-            acceleration=acceleration,
-            angular_velocity=rotation @ omega_body,
-            angular_acceleration=angular_acceleration,
-            site_forces=site_forces if self._sites_match else None,
+            forces=wanted.forces,
+            velocity=wanted.velocity,
+            acceleration=wanted.acceleration,
+            angular_velocity=wanted.angular_velocity,
+            angular_acceleration=wanted.angular_acceleration,
+            site_forces=wanted.site_forces if self._sites_match else None,
             swing_position=swing,
             swing_velocity=swing_velocity,
             posture=posture,
@@ -866,8 +851,7 @@ class MpcRider(Controller):
             self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
         self._diagnostics.update(wbc_ms=self._wbc_ms[-1])
-        command = to_motor_command(out, self.kp, self.kd)
-        return replace(command, torque=self.torque_lead(now, command.torque))
+        return to_motor_command(out, self.kp, self.kd, torque=self.torque_lead(now, out.torque))
 
     # ------------------------------------------------------------------ reports
 

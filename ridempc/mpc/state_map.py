@@ -104,18 +104,22 @@ class PlanarFrame:
             ),
         )
 
+    def rotation(self) -> Array:
+        """:math:`R_z(\\Delta\\psi)`, library axes to world axes."""
+        return self._rotation(1.0)
+
     def point_to_library(self, p: Array) -> Array:
         shifted = np.asarray(p, dtype=float) - np.array([*self.offset, 0.0])
-        return self._rotation(-1.0) @ shifted
+        return self._rotation(-1.0).dot(shifted)
 
     def vector_to_library(self, v: Array) -> Array:
-        return self._rotation(-1.0) @ np.asarray(v, dtype=float)
+        return self._rotation(-1.0).dot(np.asarray(v, dtype=float))
 
     def point_to_world(self, p: Array) -> Array:
-        return self._rotation(1.0) @ np.asarray(p, dtype=float) + np.array([*self.offset, 0.0])
+        return self._rotation(1.0).dot(np.asarray(p, dtype=float)) + np.array([*self.offset, 0.0])
 
     def vector_to_world(self, v: Array) -> Array:
-        return self._rotation(1.0) @ np.asarray(v, dtype=float)
+        return self._rotation(1.0).dot(np.asarray(v, dtype=float))
 
 
 class _AngleRate:

@@ -76,6 +76,7 @@ class ReferenceFeet:
             if name.startswith("q_")
         ]
         self._state_of_q = {index: i for i, index in self._joints}
+        self._rows: dict[bytes, NDArray[np.int64]] = {}  # state rows per order of the motors
         self._com = [names[f"com_{a}"] for a in "xyz"]
         self._angles = [names[f"{base_prefix}{a}"] for a in ("roll", "pitch", "yaw")]
         self._board_pose = board_pose
@@ -84,7 +85,11 @@ class ReferenceFeet:
     def joint_angles(self, state: Array, motor_q: NDArray[np.int64]) -> Array:
         """The state's joint angles [rad] in the order of ``motor_q`` (configuration
         indices)."""
-        return np.array([state[self._state_of_q[int(k)]] for k in motor_q])
+        key = motor_q.tobytes()
+        rows = self._rows.get(key)
+        if rows is None:  # one order of the motors per rider
+            rows = self._rows[key] = np.array([self._state_of_q[int(k)] for k in motor_q])
+        return np.asarray(state[rows], dtype=float)
 
     @property
     def plans_feet(self) -> bool:

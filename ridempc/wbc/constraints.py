@@ -115,10 +115,10 @@ class DynamicsConstraint(Constraint):
         super().__init__(layout)
         self.rows = layout.nv
         self._motor_entries = (motor_v, layout.torque.start + np.arange(layout.n_motors))
-        self._free = np.zeros(layout.nv, dtype=bool)
+        free = np.zeros(layout.nv, dtype=bool)
         if free_rows is not None:
-            self._free[free_rows] = True
-        self._any_free = bool(self._free.any())
+            free[free_rows] = True
+        self._free_rows = np.flatnonzero(free)
 
     def fill_qp_constraint(
         self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
@@ -126,14 +126,13 @@ class DynamicsConstraint(Constraint):
         layout, matrix = self.layout, block.matrix
         matrix[self._motor_entries] = -1.0  # -S^T
         matrix[:, layout.acceleration] = terms.mass_matrix
-        matrix[:, layout.force] = -terms.sites.jacobian.reshape(-1, layout.nv).T
-        matrix[:, layout.loop_force] = -terms.loop_jacobian.T
+        np.negative(terms.sites.jacobian.reshape(-1, layout.nv).T, out=matrix[:, layout.force])
+        np.negative(terms.loop_jacobian.T, out=matrix[:, layout.loop_force])
         b = terms.passive - terms.bias
-        if not self._any_free:
-            block.lower[:] = block.upper[:] = b
-            return
-        block.lower[:] = np.where(self._free, -INF, b)
-        block.upper[:] = np.where(self._free, INF, b)
+        block.lower[:] = block.upper[:] = b
+        if self._free_rows.size:
+            block.lower[self._free_rows] = -INF
+            block.upper[self._free_rows] = INF
 
 
 class RigidSpringConstraint(Constraint):
@@ -223,29 +222,35 @@ class ContactAccelerationConstraint(Constraint):
         self._split = 3 * self._first.size
         self.rows = self._split + 2 * self._second.size
         self._row_site = np.concatenate([np.repeat(self._first, 3), np.repeat(self._second, 2)])
+        # E, all sites' held directions as rows over their stacked coordinates (rows, 3 n):
+        # the first sites' identity blocks are fixed, the second sites' 2 x 3 blocks are
+        # written each tick (flat indices, in the order of their (site, row, column))
+        n = len(first)
+        self._select = np.zeros((self.rows, 3 * n))
+        for r, s in enumerate(self._first.tolist()):
+            self._select[3 * r : 3 * r + 3, 3 * s : 3 * s + 3] = np.eye(3)
+        rows = self._split + 2 * np.arange(self._second.size)[:, None, None] + np.arange(2)[:, None]
+        columns = 3 * self._second[:, None, None] + np.arange(3)
+        self._second_entries = (rows * 3 * n + columns).ravel()
 
     def fill_qp_constraint(
         self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> None:
-        nv, split = self.layout.nv, self._split
-        sites = terms.sites
+        nv, split, select = self.layout.nv, self._split, self._select
         first, second = self._first, self._second
+        sites = terms.sites
         wanted = contacts.acceleration - sites.drift
-        matrix = block.matrix
-        matrix[:split, :nv] = sites.jacobian[first].reshape(-1, nv)
         b = np.empty(self.rows)
         b[:split] = wanted[first].ravel()
         if second.size:
             basis = self._basis @ terms.site_rotation[second].transpose(0, 2, 1)  # E_s, world
-            matrix[split:, :nv] = (basis @ sites.jacobian[second]).reshape(-1, nv)
+            select.put(self._second_entries, basis)
             b[split:] = (basis @ wanted[second][:, :, None]).ravel()
+        matrix = block.matrix
+        matrix[:, :nv] = select.dot(sites.jacobian.reshape(-1, nv))
         if contacts.coupling is not None:  # a* = a + K f: the forces' part moves left
-            coupling = contacts.coupling.reshape(len(contacts.active), 3, -1)
-            matrix[:split, self.layout.force] = -coupling[first].reshape(split, -1)
-            if second.size:
-                matrix[split:, self.layout.force] = -(basis @ coupling[second]).reshape(
-                    -1, coupling.shape[-1]
-                )
+            n = 3 * len(contacts.active)
+            matrix[:, self.layout.force] = -select.dot(contacts.coupling.reshape(n, n))
         active = contacts.active[self._row_site]
         block.lower[:] = np.where(active, b, -INF)
         block.upper[:] = np.where(active, b, INF)
@@ -304,6 +309,7 @@ class FrictionPyramidConstraint(Constraint):
         self._contact_upper = np.tile([0.0, 0.0, 0.0, 0.0, max_normal_force], layout.n_sites)
         self._swing_lower = np.tile([0.0, -INF, 0.0, -INF, 0.0], layout.n_sites)
         self._swing_upper = np.tile([0.0, INF, 0.0, INF, 0.0], layout.n_sites)
+        self._bounds: dict[bytes, tuple[Array, Array]] = {}  # (lower, upper) per contact pattern
         pyramid = pyramid_matrix(friction, shape)
         # rows t1 - s n, -t1 - s n, t2 - s n, -t2 - s n, n of the frame (t1, t2, n) in the
         # box; t1 + t2 - mu n, t1 - t2 - mu n, t2 - t1 - mu n, -t1 - t2 - mu n, n in the diamond
@@ -314,9 +320,15 @@ class FrictionPyramidConstraint(Constraint):
     ) -> None:
         rows = self._pyramid @ contacts.frame  # (sites, 5, 3)
         block.matrix[self._row_index, self._column_index] = rows.ravel()
-        active = np.repeat(contacts.active, 5)
-        block.lower[:] = np.where(active, self._contact_lower, self._swing_lower)
-        block.upper[:] = np.where(active, self._contact_upper, self._swing_upper)
+        key = contacts.active.tobytes()
+        bounds = self._bounds.get(key)
+        if bounds is None:  # a few contact patterns per ride
+            active = np.repeat(contacts.active, 5)
+            bounds = self._bounds[key] = (
+                np.where(active, self._contact_lower, self._swing_lower),
+                np.where(active, self._contact_upper, self._swing_upper),
+            )
+        block.lower[:], block.upper[:] = bounds
         if contacts.least_force is not None:
             normal = 5 * np.arange(self.layout.n_sites) + 4
             bounded = contacts.active & (contacts.least_force > 0.0)
@@ -353,35 +365,33 @@ class PlatformTipConstraint(Constraint):
         self.rows = 2 * platforms
         self._lower = np.full(self.rows, -INF)
         self._upper = np.zeros(self.rows)
-        self._entries: dict[bytes, tuple[Index, Index, Index]] = {}
+        self._entries: dict[tuple[bytes, ...], tuple[Index, Index, Index]] = {}
 
-    def _indices(self, sites: Index, counts: list[int]) -> tuple[Index, Index, Index]:
-        """The rows (+ and -) and columns of each site's three force components, for the
-        platforms' sites in a row (``counts`` each; a few distinct lists per ride)."""
-        key = sites.tobytes() + bytes(counts)
+    def _indices(self, sites: tuple[Index, ...]) -> tuple[Index, Index, Index]:
+        """The platforms' sites in a row, and the flat indices (rows ``+`` and ``-``, in the
+        block's own matrix) of their three force components; a few distinct lists per ride."""
+        key = tuple(s.tobytes() for s in sites)
         cached = self._entries.get(key)
         if cached is None:
-            platform = np.repeat(np.arange(len(counts)), counts)
-            columns = (self.layout.force.start + 3 * sites[:, None] + np.arange(3)).ravel()
-            plus = np.repeat(2 * platform, 3)
-            cached = self._entries[key] = (plus, plus + 1, columns)
+            stacked = np.concatenate(sites)
+            platform = np.repeat(np.arange(len(sites)), [len(s) for s in sites])
+            columns = (self.layout.force.start + 3 * stacked[:, None] + np.arange(3)).ravel()
+            plus = np.repeat(2 * platform, 3) * self.layout.size + columns
+            cached = self._entries[key] = (stacked, plus, plus + self.layout.size)
         return cached
 
     def fill_qp_constraint(
         self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> None:
-        matrix = block.matrix
         tipping = contacts.tipping[: self.rows // 2]
         if tipping:
-            counts = [len(t[0]) for t in tipping]
-            sites = np.concatenate([t[0] for t in tipping])
-            plus, minus, columns = self._indices(sites, counts)
+            sites, plus, minus = self._indices(tuple(t[0] for t in tipping))
             offsets = np.concatenate([t[1] for t in tipping])[:, None]
             ratio = np.concatenate([t[2] for t in tipping])[:, None]
             axes = contacts.frame[sites]
             side, normal = axes[:, 1], axes[:, 2]
-            matrix[plus, columns] = ((offsets - ratio) * normal - side).ravel()
-            matrix[minus, columns] = ((-offsets - ratio) * normal + side).ravel()
+            block.matrix.put(plus, (offsets - ratio) * normal - side)
+            block.matrix.put(minus, (-offsets - ratio) * normal + side)
         block.lower[:] = self._lower
         block.upper[:] = self._upper
 

@@ -23,11 +23,11 @@ A site is *active* when its foot is planned in contact. It then stays on its sup
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.estimation.state import BoardEstimate
@@ -43,17 +43,9 @@ _XYZ = np.arange(3)
 
 
 def platform_rotation(board: BoardEstimate) -> Array:
-    """:math:`R_{WP} = R_z(\\psi) R_y(\\theta) R_x(\\phi)` of a board estimate."""
-    cy, sy = math.cos(board.yaw), math.sin(board.yaw)
-    cp, sp = math.cos(board.pitch), math.sin(board.pitch)
-    cr, sr = math.cos(board.roll), math.sin(board.roll)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
+    """:math:`R_{WP} = R_z(\\psi) R_y(\\theta) R_x(\\phi)` of a board estimate (Pinocchio's
+    ``rpyToMatrix``)."""
+    return np.asarray(pin.rpy.rpyToMatrix(board.roll, board.pitch, board.yaw))
 
 
 @dataclass(frozen=True)
@@ -159,7 +151,8 @@ def build_contact_set(
         sites = _sites_on(site_foot, names, board.feet)
         if sites.size == 0:
             continue
-        frame[sites] = platform_rotation(board).T
+        rotation = platform_rotation(board)
+        frame[sites] = rotation.T
         lever = terms.sites.position[sites] - board.position
         centripetal = -(board.yaw_rate**2) * lever  # omega x (omega x r), omega along z
         centripetal[:, 2] = 0.0
@@ -174,7 +167,7 @@ def build_contact_set(
             into, taken = _block_entries(sites, n)
             coupling.ravel()[into] = response.coupling.ravel()[taken]
             if platform.tread is not None:
-                offsets = lever @ frame[sites[0], 1] / platform.height  # y_s / h
+                offsets = lever.dot(rotation[:, 1]) / platform.height  # y_s / h
                 ratio = np.full(len(sites), 0.5 * platform.tread / platform.height)
                 tipping.append((sites, offsets, ratio))
         acceleration[sites] = centripetal

@@ -281,7 +281,7 @@ class WholeBodyController:
         x = solution.x
         acceleration = x[layout.acceleration]
         site_forces = x[layout.force].reshape(-1, 3)
-        feet = self._site_to_foot @ site_forces
+        feet = self._site_to_foot.dot(site_forces)
         qdd = acceleration[self.motor_v]
         velocity = v[self.motor_v]
         return WbcOutput(
@@ -301,7 +301,9 @@ class WholeBodyController:
         )
 
 
-def to_motor_command(output: WbcOutput, kp: Array | float, kd: Array | float) -> MotorCommand:
+def to_motor_command(
+    output: WbcOutput, kp: Array | float, kd: Array | float, torque: Array | None = None
+) -> MotorCommand:
     """The motor drivers' command: the QP's torques as feedforward, PD about its targets,
     :math:`\\tau_{motor} = \\tau + k_p (q^* - q) + k_d (\\dot q^* - \\dot q)` [N m].
 
@@ -309,10 +311,12 @@ def to_motor_command(output: WbcOutput, kp: Array | float, kd: Array | float) ->
         output: The WBC's answer.
         kp: Joint stiffness [N m / rad], one per motor or one for all.
         kd: Joint damping [N m s / rad], one per motor or one for all.
+        torque: The feedforward to send in place of the QP's [N m] (e.g. led over the
+            motors' delay, :mod:`~ridempc.wbc.torque_lead`).
     """
     n = output.torque.size
     return MotorCommand(
-        torque=output.torque.copy(),
+        torque=(output.torque if torque is None else np.asarray(torque, dtype=float)).copy(),
         position=output.position.copy(),
         velocity=output.velocity.copy(),
         kp=_per_motor(kp, n),

@@ -68,12 +68,18 @@ class TorquesInFlight:
             self.site_motor[[first, second]] = motor
             self.site_lever[[first, second]] = lever
         self._dt = dt
-        self._torques: deque[tuple[float, Array]] = deque(maxlen=max(self.window, 1))
+        # (site, motor, lever, foot) of each site on a line foot: a few per robot, so the
+        # bounds are worked out in plain floats, where NumPy's per-call cost dominates
+        self._lined = [
+            (s, int(self.site_motor[s]), float(self.site_lever[s]), int(self.site_foot[s]))
+            for s in np.flatnonzero(self.site_motor >= 0).tolist()
+        ]
+        self._torques: deque[tuple[float, list[float]]] = deque(maxlen=max(self.window, 1))
 
     def record(self, time: float, torque: Array) -> None:
         """Keep the motor torques [N m] (actuator order) the QP asked for at ``time`` [s]."""
         if self.window:
-            self._torques.append((time, np.array(torque, dtype=float)))
+            self._torques.append((time, np.asarray(torque, dtype=float).tolist()))
 
     def least_forces(self, time: float, foot_normal_forces: Array) -> Array | None:
         """Each contact site's least normal force at ``time`` [s] [N], or None (no bound).
@@ -85,15 +91,14 @@ class TorquesInFlight:
             time: This tick's time [s].
             foot_normal_forces: Each foot's planned normal force [N].
         """
-        lined = self.site_motor >= 0
         earliest, latest = time - (self.window + 0.5) * self._dt, time - 0.5 * self._dt
         recent = [tau for t, tau in self._torques if earliest <= t <= latest]
-        if len(recent) < 2 or not lined.any():
+        if len(recent) < 2 or not self._lined:
             return None
-        torques = np.array(recent)
-        spread = torques.max(axis=0) - torques.min(axis=0)
-        least = np.zeros(len(self.site_motor))
-        motor = self.site_motor[lined]
-        least[lined] = spread[motor] / self.site_lever[lined]
-        half = 0.5 * np.maximum(np.asarray(foot_normal_forces)[self.site_foot], 0.0)
-        return np.minimum(least, half)
+        forces = np.asarray(foot_normal_forces, dtype=float).tolist()
+        least = [0.0] * len(self.site_motor)
+        for site, motor, lever, foot in self._lined:
+            torques = [tau[motor] for tau in recent]
+            spread = (max(torques) - min(torques)) / lever
+            least[site] = min(spread, 0.5 * max(forces[foot], 0.0))
+        return np.array(least)

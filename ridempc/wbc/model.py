@@ -19,8 +19,10 @@ in the base frame), everything the tasks and constraints read:
   :math:`\\dot J_{loop} v`, so that :math:`\\ddot r = J_{loop} \\ddot q + \\dot J_{loop} v`.
 
 The drifts are Pinocchio's classical accelerations at :math:`\\ddot q = 0`
-(``forwardKinematics(q, v, 0)`` then ``getFrameClassicalAcceleration``): the spatial
-acceleration's linear part plus :math:`\\omega \\times \\dot p`.
+(``getFrameClassicalAcceleration``): the spatial acceleration's linear part plus
+:math:`\\omega \\times \\dot p`. ``computeAllTerms`` leaves in its data the joints'
+accelerations of its bias pass, the motion at :math:`\\ddot q = 0`, which is what
+``forwardKinematics(q, v, 0)`` would compute again (checked in the WBC's tests).
 """
 
 from __future__ import annotations
@@ -100,7 +102,7 @@ class ModelTerms(NamedTuple):
     @property
     def base_angular_velocity_world(self) -> Array:
         """:math:`\\omega_W = R_{WB}\\, \\omega_B` [rad/s]."""
-        return np.asarray(self.base_rotation @ self.base_angular_velocity)
+        return np.asarray(self.base_rotation.dot(self.base_angular_velocity))
 
 
 class WholeBodyModel:
@@ -164,8 +166,10 @@ class WholeBodyModel:
         self._stiffness = self.pinocchio.spring_stiffness[self._stiff_v]
         self._spring_reference = self.pinocchio.spring_reference[self._stiff_v]
         self._damping = np.array(model.damping, dtype=float)
-        self._zero = np.zeros(model.nv)
-        self._lower = np.tril_indices(model.nv, -1)
+        # M's strict lower triangle, and the upper entries it mirrors, as flat indices
+        lower_rows, lower_cols = np.tril_indices(model.nv, -1)
+        self._lower = lower_rows * model.nv + lower_cols
+        self._mirror = lower_cols * model.nv + lower_rows
         # every frame read per tick: the base, the sites, then each closure's two anchors
         pairs = self.closure.pairs
         self._frames = (
@@ -179,6 +183,11 @@ class WholeBodyModel:
         self._first_anchor_rows = slice(1 + n_sites, 1 + n_sites + n_loops)
         self._second_anchor_rows = slice(1 + n_sites + n_loops, 1 + n_sites + 2 * n_loops)
         self.site_partner, self.line_basis = self._line_feet()
+        # each foot's sites summed (a 0/1 matrix), and their count, for foot_points
+        feet = self.legs.site_foot
+        self._foot_sum = np.zeros((len(self.foot_names), len(feet)))
+        self._foot_sum[feet, np.arange(len(feet))] = 1.0
+        self._foot_count = np.bincount(feet, minlength=len(self.foot_names))[:, None]
 
     def _line_feet(self) -> tuple[Index, Array]:
         """For each site, the first site of its foot if it is a line foot's second one
@@ -244,12 +253,7 @@ class WholeBodyModel:
         model, data = self.model, self._points_data
         pin.framesForwardKinematics(model, data, np.asarray(q, dtype=float))
         sites = np.array([data.oMf[f].translation for f in self.site_frames])
-        feet = self.legs.site_foot
-        count = np.bincount(feet, minlength=len(self.foot_names))[:, None]
-        return np.asarray(
-            np.stack([np.bincount(feet, sites[:, k], len(self.foot_names)) for k in range(3)], 1)
-            / count
-        )
+        return np.asarray(self._foot_sum.dot(sites) / self._foot_count)
 
     def passive_torque(self, q: Array, v: Array) -> Array:
         """:math:`\\tau_p = -K (q - q_{ref}) - D v` [N m] (springs and joint damping)."""
@@ -262,37 +266,41 @@ class WholeBodyModel:
         model, data = self.model, self.data
         q = np.asarray(q, dtype=float)
         v = np.asarray(v, dtype=float)
-        pin.computeAllTerms(model, data, q, v)  # M (upper triangle), h, joint Jacobians, CoM
+        nv = model.nv
+        # M (upper triangle), h, joint Jacobians, CoM and the joints' motion at qdd = 0
+        pin.computeAllTerms(model, data, q, v)
         mass = np.array(data.M)
-        mass[self._lower] = mass.T[self._lower]  # Pinocchio fills the upper triangle
-        bias = np.array(data.nle)
-        com_jacobian = np.array(data.Jcom)
-        pin.forwardKinematics(model, data, q, v, self._zero)  # accelerations = drifts
+        flat = mass.reshape(-1)
+        flat.put(self._lower, flat.take(self._mirror))  # Pinocchio fills the upper triangle
         pin.updateFramePlacements(model, data)
         pin.centerOfMass(model, data, pin.KinematicLevel.ACCELERATION, False)
         com = PointKinematics(
-            np.array(data.com[0]), np.array(data.vcom[0]), com_jacobian, np.array(data.acom[0])
+            np.array(data.com[0]),
+            np.array(data.vcom[0]),
+            np.array(data.Jcom),
+            np.array(data.acom[0]),
         )
         frames = self._frames
-        positions = np.empty((len(frames), 3))
-        rotations = np.empty((len(frames), 3, 3))
-        jacobians = np.empty((len(frames), 3, model.nv))
-        drifts = np.empty((len(frames), 3))
-        placements = data.oMf
-        for k, frame in enumerate(frames):
-            placement = placements[frame]
-            positions[k] = placement.translation
-            if k < self._site_rows.stop:  # the base and the sites
-                rotations[k] = placement.rotation
-            jacobians[k] = pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3]
-            drifts[k] = pin.getFrameClassicalAcceleration(model, data, frame, WORLD_ALIGNED).linear
+        placements = [data.oMf[frame] for frame in frames]
+        positions = np.array([placement.translation for placement in placements])
+        # orientations of the base and the sites only (the anchors' are not read)
+        rotations = np.array([p.rotation for p in placements[: self._site_rows.stop]])
+        jacobians = np.array(
+            [pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3] for frame in frames]
+        )
+        drifts = np.array(
+            [
+                pin.getFrameClassicalAcceleration(model, data, frame, WORLD_ALIGNED).linear
+                for frame in frames
+            ]
+        )
         velocities = jacobians @ v
         sites, first, second = self._site_rows, self._first_anchor_rows, self._second_anchor_rows
         return ModelTerms(
             q=q,
             v=v,
             mass_matrix=mass,
-            bias=bias,
+            bias=np.array(data.nle),
             passive=self.passive_torque(q, v),
             base_rotation=rotations[0],
             base_angular_velocity=v[3:6].copy(),
@@ -303,6 +311,6 @@ class WholeBodyModel:
             ),
             site_rotation=rotations[sites],
             loop_residual=(positions[first] - positions[second]).ravel(),
-            loop_jacobian=(jacobians[first] - jacobians[second]).reshape(-1, model.nv),
+            loop_jacobian=(jacobians[first] - jacobians[second]).reshape(-1, nv),
             loop_drift=(drifts[first] - drifts[second]).ravel(),
         )

@@ -41,6 +41,7 @@ from ridempc.estimation.state import BoardEstimate
 __all__ = ["PlatformResponse", "RollingPlatform"]
 
 Array = NDArray[np.float64]
+_ZERO_ROW: tuple[float, float, float] = (0.0, 0.0, 0.0)  # nothing moves the shoe vertically
 
 
 @dataclass(frozen=True)
@@ -83,8 +84,12 @@ class RollingPlatform:
 
     def response(self, board: BoardEstimate) -> PlatformResponse:
         """The shoe's response at the estimated pitch and heading."""
-        heading = np.array([math.cos(board.yaw), math.sin(board.yaw), 0.0])
+        # plain floats: a 3 x 3 block per tick, where NumPy's per-call cost dominates
+        c, s, m = math.cos(board.yaw), math.sin(board.yaw), self.mass
+        push = self.drive * board.pitch / m
         return PlatformResponse(
-            drift=(self.drive * board.pitch / self.mass) * heading,
-            coupling=-(heading[:, None] * heading[None, :]) / self.mass,
+            drift=np.array([push * c, push * s, 0.0]),
+            coupling=np.array(
+                [[-(c * c) / m, -(c * s) / m, 0.0], [-(s * c) / m, -(s * s) / m, 0.0], _ZERO_ROW]
+            ),
         )

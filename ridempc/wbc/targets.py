@@ -20,6 +20,13 @@ from ridempc.errors import ConfigError
 __all__ = ["WbcOutput", "WbcTargets"]
 
 Array = NDArray[np.float64]
+_VECTORS: tuple[str, ...] = (  # the targets' 3-vectors, made float arrays
+    "position",
+    "velocity",
+    "acceleration",
+    "angular_velocity",
+    "angular_acceleration",
+)
 
 
 def _zeros3() -> Array:
@@ -79,23 +86,54 @@ class WbcTargets:
     site_forces: Array | None = None
 
     def __post_init__(self) -> None:
-        for name in (
-            "position",
-            "velocity",
-            "acceleration",
-            "angular_velocity",
-            "angular_acceleration",
-        ):
-            _check_shape(name, getattr(self, name), (3,))
+        for name in _VECTORS:
             object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float))
-        _check_shape("orientation", self.orientation, (4,))
         orientation = np.asarray(self.orientation, dtype=float)
+        if self.site_forces is not None:
+            object.__setattr__(self, "site_forces", np.asarray(self.site_forces, dtype=float))
+        if not self._shapes_fit():
+            self._check_each()  # raises, naming the field
         norm = math.sqrt(orientation.dot(orientation))  # np.linalg.norm's sum
         if abs(norm - 1.0) > 1e-3:
             raise ConfigError(
                 f"WBC targets: field 'orientation': not a unit quaternion (norm {norm:.6f})"
             )
         object.__setattr__(self, "orientation", orientation / norm)
+
+    def _shapes_fit(self) -> bool:
+        """Whether every field has its shape and finite values, checked at once (a tick's
+        dozen small checks one by one cost more than the rest of the targets)."""
+        feet = len(self.contact)
+        arrays = [getattr(self, name) for name in _VECTORS]
+        shapes: list[tuple[int, ...]] = [(3,)] * len(arrays)
+        arrays.append(np.asarray(self.orientation))
+        shapes.append((4,))
+        for name in ("forces", "swing_position", "swing_velocity", "swing_acceleration"):
+            value = getattr(self, name)
+            if value is not None:
+                arrays.append(np.asarray(value))
+                shapes.append((feet, 3))
+        if self.site_forces is not None:
+            arrays.append(self.site_forces)
+            shapes.append((len(self.site_forces), 3))
+        for acceleration in self.board_acceleration:
+            arrays.append(np.asarray(acceleration))
+            shapes.append((3,))
+        if any(a.shape != shape for a, shape in zip(arrays, shapes, strict=True)):
+            return False
+        if any(a.dtype.kind not in "fiu" for a in arrays):
+            return False
+        return bool(np.isfinite(np.concatenate([a.ravel() for a in arrays])).all())
+
+    def _check_each(self) -> None:
+        """Each field's shape and values, one by one.
+
+        Raises:
+            ConfigError: The first field of the wrong shape or with a value not finite.
+        """
+        for name in _VECTORS:
+            _check_shape(name, getattr(self, name), (3,))
+        _check_shape("orientation", self.orientation, (4,))
         feet = len(np.asarray(self.contact))
         _check_shape("forces", self.forces, (feet, 3))
         for name in ("swing_position", "swing_velocity", "swing_acceleration"):
@@ -103,9 +141,7 @@ class WbcTargets:
             if value is not None:
                 _check_shape(name, value, (feet, 3))
         if self.site_forces is not None:
-            sites = np.asarray(self.site_forces)
-            _check_shape("site_forces", sites, (len(sites), 3))
-            object.__setattr__(self, "site_forces", np.asarray(sites, dtype=float))
+            _check_shape("site_forces", self.site_forces, (len(self.site_forces), 3))
         for k, acceleration in enumerate(self.board_acceleration):
             _check_shape(f"board_acceleration[{k}]", acceleration, (3,))
 

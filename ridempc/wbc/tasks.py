@@ -47,6 +47,7 @@ __all__ = [
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 _EYE3 = np.eye(3)
+# Small products by ``.dot``: NumPy 2's ``@`` costs some 2 us more a call at these sizes.
 NORMAL_SHARE: float = 0.1  # [-] weight of a site's normal force share, over its tangential
 
 
@@ -60,6 +61,26 @@ class Objective(NamedTuple):
 
     hessian: Array
     gradient: Array
+
+
+class _PatternTerms(NamedTuple):
+    """:class:`ContactForceTask`'s terms for one contact pattern.
+
+    Attributes:
+        foot_hessian: The foot term's Hessian block on the forces.
+        foot_gradient: Its gradient per wanted foot force.
+        share: Each site's even share of its foot's wanted force.
+        site_weight: :math:`w_s / m^2` per site, zero for a site whose foot is in the air.
+        site_hessian: The site term's Hessian block with the MPC's site forces.
+        standing_sites: 1 for each force component of a site whose foot stands, else 0.
+    """
+
+    foot_hessian: Array
+    foot_gradient: Array
+    share: Array
+    site_weight: Array
+    site_hessian: Array
+    standing_sites: Array
 
 
 class Task(ABC):
@@ -93,8 +114,8 @@ class Task(ABC):
         """Add :math:`(H, c)` of :math:`\\tfrac w2\\|J \\ddot q - b\\|^2`."""
         nv = self.layout.nv
         weighted = weight * jacobian.T
-        out.hessian[:nv, :nv] += weighted @ jacobian
-        out.gradient[:nv] -= weighted @ b
+        out.hessian[:nv, :nv] += weighted.dot(jacobian)
+        out.gradient[:nv] -= weighted.dot(b)
 
 
 class BaseOrientationTask(Task):
@@ -123,14 +144,14 @@ class BaseOrientationTask(Task):
         rotation = terms.base_rotation
         w, x, y, z = targets.orientation  # a unit quaternion (WbcTargets normalises it)
         wanted = pin.Quaternion(w, x, y, z).toRotationMatrix()
-        omega = rotation @ terms.base_angular_velocity  # world axes
+        omega = rotation.dot(terms.base_angular_velocity)  # world axes
         alpha = (
             targets.angular_acceleration
-            + g.kp * pin.log3(wanted @ rotation.T)
+            + g.kp * pin.log3(wanted.dot(rotation.T))
             + g.kd * (targets.angular_velocity - omega)
         )
         out.hessian[self._diagonal] += g.weight
-        out.gradient[3:6] -= g.weight * (rotation.T @ alpha)
+        out.gradient[3:6] -= g.weight * rotation.T.dot(alpha)
 
 
 class TranslationTask(Task):
@@ -238,11 +259,10 @@ class ContactForceTask(Task):
         self._block_rows = np.broadcast_to(block + np.arange(3)[:, None], (n_sites, 3, 3)).ravel()
         self._block_cols = np.broadcast_to(block + np.arange(3)[None, :], (n_sites, 3, 3)).ravel()
         self._identity_blocks = np.tile(_EYE3.ravel(), n_sites)
-        self._by_contacts: dict[bytes, tuple[Array, Array, Array]] = {}
+        self._by_contacts: dict[bytes, _PatternTerms] = {}
 
-    def _terms(self, standing: NDArray[np.bool_]) -> tuple[Array, Array, Array]:
-        """The foot term's Hessian block and gradient map (per wanted foot force), and the
-        share map, for a contact pattern."""
+    def _terms(self, standing: NDArray[np.bool_]) -> _PatternTerms:
+        """What depends on the contact pattern alone, made once per pattern."""
         key = standing.tobytes()
         cached = self._by_contacts.get(key)
         if cached is None:
@@ -250,7 +270,19 @@ class ContactForceTask(Task):
             sites = standing[self._site_rows].astype(float)
             total = self._total * feet[:, None] * sites[None, :]
             share = self._share * sites[:, None] * feet[None, :]
-            cached = (self._foot_weight * (total.T @ total), -self._foot_weight * total.T, share)
+            weight = np.asarray(self._site_weight * standing[self._site_foot], dtype=float)
+            site_hessian = np.zeros((3 * len(self._site_foot), 3 * len(self._site_foot)))
+            site_hessian[self._block_rows, self._block_cols] = (
+                np.repeat(weight, 9) * self._identity_blocks
+            )
+            cached = _PatternTerms(
+                self._foot_weight * (total.T @ total),
+                -self._foot_weight * total.T,
+                share,
+                weight,
+                site_hessian,
+                np.repeat(standing[self._site_foot].astype(float), 3),
+            )
             self._by_contacts[key] = cached
         return cached
 
@@ -258,17 +290,16 @@ class ContactForceTask(Task):
         self, out: Objective, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> None:
         standing = np.asarray(targets.contact, dtype=bool)
-        foot_hessian, foot_gradient, share = self._terms(standing)
-        weight = self._site_weight * standing[self._site_foot]
-        site_hessian = np.zeros_like(foot_hessian)
+        pattern = self._terms(standing)
         wanted = np.asarray(targets.forces, dtype=float).ravel()
         if targets.site_forces is None:
+            site_hessian = np.zeros_like(pattern.foot_hessian)
             normal = contacts.normal
             tangential = _EYE3 - (1.0 - NORMAL_SHARE) * normal[:, :, None] * normal[:, None, :]
             site_hessian[self._block_rows, self._block_cols] = (
-                tangential * weight[:, None, None]
+                tangential * pattern.site_weight[:, None, None]
             ).ravel()
-            site_wanted = share @ wanted
+            site_wanted = pattern.share.dot(wanted)
         else:
             if targets.site_forces.shape != (len(self._site_foot), 3):
                 raise ConfigError(
@@ -277,15 +308,11 @@ class ContactForceTask(Task):
                 )
             # the MPC's own site forces, normal part included, at the site weight (holding
             # them as strongly as the feet's totals felled Cassie on the Segway at 1.2 s)
-            site_hessian[self._block_rows, self._block_cols] = (
-                np.repeat(weight, 9) * self._identity_blocks
-            )
-            site_wanted = targets.site_forces.ravel() * np.repeat(
-                standing[self._site_foot].astype(float), 3
-            )
+            site_hessian = pattern.site_hessian
+            site_wanted = targets.site_forces.ravel() * pattern.standing_sites
         forces = self.layout.force
-        out.hessian[forces, forces] += foot_hessian + site_hessian
-        out.gradient[forces] += foot_gradient @ wanted - site_hessian @ site_wanted
+        out.hessian[forces, forces] += pattern.foot_hessian + site_hessian
+        out.gradient[forces] += pattern.foot_gradient.dot(wanted) - site_hessian.dot(site_wanted)
 
 
 class SwingFootTask(Task):
@@ -321,9 +348,9 @@ class SwingFootTask(Task):
         feet = np.flatnonzero(swinging)
         mean = self._mean[feet]
         sites = terms.sites
-        position = mean @ sites.position
-        velocity = mean @ sites.velocity
-        drift = mean @ sites.drift
+        position = mean.dot(sites.position)
+        velocity = mean.dot(sites.velocity)
+        drift = mean.dot(sites.drift)
         jacobian = np.tensordot(mean, sites.jacobian, axes=1).reshape(3 * len(feet), -1)
         zero = np.zeros((len(feet), 3))
         wanted_velocity = zero if targets.swing_velocity is None else targets.swing_velocity[feet]
