@@ -30,6 +30,7 @@ from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import RunResult, Simulation
+from ridempc.sim.terrain import lay_out
 from ridempc.units import MAX_DURATION, MIN_DURATION
 
 if TYPE_CHECKING:
@@ -159,6 +160,13 @@ def check_request(request: RideRequest) -> CheckedRide:
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
 
+    terrain = None
+    if scenario.terrain:
+        radius = getattr(board.params, "wheel_radius", None) if board is not None else None
+        try:
+            terrain = lay_out(scenario.terrain, radius, board_name)
+        except ConfigError as exc:
+            raise ConfigError(f"scenario '{scenario.name}': {exc}") from exc
     scene = build_scene(
         robot,
         request.physics_hz,
@@ -166,6 +174,7 @@ def check_request(request: RideRequest) -> CheckedRide:
         dead_weight=dead_weight,
         foot_offset=scenario.foot_offset,
         platform_offsets=scenario.platform_offsets,
+        terrain=terrain,
     )
     height = float(scene.data.xpos[scene.base_body, 2])
     frame_callbacks: list[Callable[[Any, Any], None]] = []

@@ -42,6 +42,9 @@ non-physical values are refused with the field named). Example::
     gain = "pitch_kp"          # Hovershoes: pitch_kp, pitch_kd, tilt_back_gain; Segway: [gains]
     scale = 0.8
 
+Terrain (slopes, steps, stairs, rough patches, raised strips, boxes) is a list of
+``[[terrain]]`` tables, described in :mod:`ridempc.scenarios.terrain`.
+
 The other knobs: ``tyre_friction``, ``deck_friction`` [-], ``wheel_radius`` [m],
 ``bushing_stiffness`` [N m/rad] and ``bushing_damping`` [N m s/rad] (skateboard),
 ``base_payload`` [kg], ``motor_torque_limit`` (scale only) and ``joint_damping``
@@ -59,6 +62,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from ridempc.scenarios.terrain import TerrainItem, check_terrain
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
@@ -273,6 +277,12 @@ class Scenario(_Frozen):
     changes: tuple[ParameterChange, ...] = ()
     noise: SensorNoise = SensorNoise()
     push_off: PushOff | None = None
+    terrain: tuple[TerrainItem, ...] = ()  # [[terrain]]: see ridempc.scenarios.terrain
+
+    @model_validator(mode="after")
+    def _terrain_fits(self) -> Scenario:
+        check_terrain(self.terrain)
+        return self
 
     @model_validator(mode="after")
     def _ordered(self) -> Scenario:
