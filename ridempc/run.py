@@ -27,6 +27,7 @@ from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, load_scenario_file, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.levelling import step_levelling
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import RunResult, Simulation
@@ -362,6 +363,7 @@ def _summary(
         or (controller is not None and controller.uses_ground_truth),
         "rider_mass_kg": round(scene.rider_mass, 4),
         **run_metrics(result, scenario, robot),
+        **step_levelling(result.log, scenario),
         **(controller.summary() if controller is not None else {}),
         "files": files,
     }

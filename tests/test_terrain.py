@@ -16,6 +16,7 @@ from ridempc.run import RideRequest, check_request
 from ridempc.scenarios import load_scenario_file
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.falls import FallDetector
+from ridempc.sim.levelling import step_levelling
 from ridempc.sim.scene import build_scene
 from ridempc.sim.terrain import STEP_DOWN_RADII, lay_out
 
@@ -153,3 +154,41 @@ def test_falls_are_judged_against_the_terrain_under_the_rider(tmp_path: Path) ->
     data.qpos[root + 2] += 0.6
     mujoco.mj_forward(model, data)
     assert falls.check(model, data) is None
+
+
+def test_a_short_ride_down_a_curb(tmp_path: Path) -> None:
+    """A dead weight on the Segway, pushed for 0.6 s, rolls down a curb of half its wheel
+    radius: no fall, the board a curb lower, the step's crossing in the summary."""
+    path = tmp_path / "curb.toml"
+    path.write_text(
+        'name = "curb"\nduration = 2.0\n'
+        '[[disturbances]]\nt = 0.0\nbody = "base"\nforce = [150.0, 0.0, 0.0]\nduration = 0.6\n'
+        '[[terrain]]\nkind = "step"\nat = 0.6\nheight_radii = 0.5\ndirection = "down"\n'
+    )
+    checked = check_request(RideRequest("none", "segway", "dead-weight", path, out=None))
+    result = checked.simulation.run()
+    assert result.status == "ok", result.fall_reason
+    curb = 0.5 * load_board("segway").params.wheel_radius  # type: ignore[attr-defined]
+    z = result.log["board_position"][:, 0, 2]
+    assert z[0] - z[-1] == pytest.approx(curb, abs=0.005)
+    steps = step_levelling(result.log, checked.scenario)["steps"]
+    assert steps[0]["x_m"] == 0.6
+    assert 0.0 < steps[0]["crossed_s"] < 2.0
+
+
+def test_level_after_is_the_time_from_the_crossing_to_the_last_tilt(tmp_path: Path) -> None:
+    scenario = _load(tmp_path, STEP)  # an edge at x = 2 m
+    time = np.arange(0.0, 3.0, 0.01)
+    position = np.zeros((len(time), 2, 3))
+    position[:, :, 0] = time[:, None]  # both platforms at 1 m/s: crossing at 2 s
+    position[:, 1, 0] -= 0.05  # the second one 5 cm behind: crossing at 2.05 s
+    tilt = np.where((time > 2.1) & (time < 2.4), math.radians(5.0), 0.0)
+    quaternion = np.zeros((len(time), 2, 4))
+    quaternion[:, :, 0] = np.cos(tilt / 2)[:, None]
+    quaternion[:, :, 2] = np.sin(tilt / 2)[:, None]  # pitched about y
+    log = {"time": time, "board_position": position, "board_quaternion": quaternion}
+    (step,) = step_levelling(log, scenario)["steps"]
+    assert step["crossed_s"] == pytest.approx(2.05, abs=0.011)
+    assert step["level_after_s"] == pytest.approx(0.35, abs=0.011)
+    quaternion[-1, 0] = [np.cos(0.1), 0.0, np.sin(0.1), 0.0]  # tilted at the end: never level
+    assert step_levelling(log, scenario)["steps"][0]["level_after_s"] is None

@@ -72,6 +72,7 @@ __all__ = [
     "WORLD_HALF_WIDTH",
     "check_terrain",
     "footprint",
+    "step_edges",
 ]
 
 # The world: a 100 m run ahead of the start (200 s at 0.5 m/s, beyond any scenario) and 10 m
@@ -223,6 +224,15 @@ def footprint(item: TerrainItem) -> tuple[float, float, float, float]:
         item.center[1] - half[1],
         item.center[1] + half[1],
     )
+
+
+def step_edges(items: tuple[TerrainItem, ...]) -> tuple[float, ...]:
+    """Where each step's edge lies along x [m], stairs one per step, in order along x."""
+    edges = [item.at for item in items if isinstance(item, Step)]
+    for item in items:
+        if isinstance(item, Stairs):
+            edges += [item.at + k * item.tread for k in range(item.count)]
+    return tuple(sorted(edges))
 
 
 def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
