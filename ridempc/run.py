@@ -167,7 +167,9 @@ def check_request(request: RideRequest) -> CheckedRide:
         try:
             terrain = lay_out(scenario.terrain, radius, board_name)
         except ConfigError as exc:
-            raise ConfigError(f"scenario '{scenario.name}': {exc}") from exc
+            given = str(request.scenario)
+            path = isinstance(request.scenario, Path) or given.endswith(".toml") or "/" in given
+            raise ConfigError(f"{given if path else f'scenario {scenario.name!r}'}: {exc}") from exc
     scene = build_scene(
         robot,
         request.physics_hz,
