@@ -3,13 +3,21 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from ridempc.boards import load_board
 from ridempc.estimation.state import BoardEstimate
+from ridempc.mpc.rider import MpcRider
 from ridempc.mpc.slope import GRAVITY, SlopeEstimator
 from ridempc.mpc.state_map import PlanarFrame
+from ridempc.robots import load_robot
+from ridempc.scenarios import resolve_scenario
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.scene import build_scene
+from ridempc.sim.simulation import Simulation
 
 
 def _board(speed: float, angle_deg: float, yaw: float = 0.0, z: float = 0.0) -> BoardEstimate:
@@ -43,3 +51,29 @@ def test_the_library_frame_carries_the_grounds_height() -> None:
     p = np.array([0.3, -0.2, 0.8])
     assert frame.point_to_world(frame.point_to_library(p)) == pytest.approx(p)
     assert frame.point_to_library(np.array([3.0, 2.0, -0.1])) == pytest.approx([1.0, 0.0, 0.0])
+
+
+def test_the_mpc_frame_follows_the_ground_under_the_platforms() -> None:
+    """Platforms 0.1 m lower than where they started: the library frame sinks with them,
+    so the rider's centre of mass keeps its height over them in the MPC's state."""
+    dog = load_robot("cyberdog2")
+    scenario = resolve_scenario("stand-still", "skateboard").with_duration(0.1)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    rider = MpcRider(dog, "skateboard")
+    Simulation(scene, rider, scenario).run()
+    estimate = rider.estimator.state
+    assert estimate is not None and estimate.boards
+    n, state_map = rider.layout.names, rider.map
+    later = replace(estimate, time=estimate.time + 1.0)  # ten filter time constants later
+    level = state_map.follow_ground(later)
+    before = state_map.state(estimate)
+    lowered = replace(
+        estimate,
+        time=estimate.time + 2.0,
+        boards=tuple(
+            replace(b, position=b.position - np.array([0.0, 0.0, 0.1])) for b in estimate.boards
+        ),
+    )
+    assert state_map.follow_ground(lowered) - level == pytest.approx(-0.1, abs=1e-3)
+    after = state_map.state(estimate)
+    assert after[n["com_z"]] - before[n["com_z"]] == pytest.approx(0.1, abs=1e-3)
