@@ -42,14 +42,14 @@ non-physical values are refused with the field named). Example::
     gain = "pitch_kp"          # Hovershoes: pitch_kp, pitch_kd, tilt_back_gain; Segway: [gains]
     scale = 0.8
 
-Terrain (slopes, steps, stairs, rough patches, raised strips, boxes) is a list of
-``[[terrain]]`` tables, described in :mod:`ridempc.scenarios.terrain`.
-
 The other knobs: ``tyre_friction``, ``deck_friction`` [-], ``wheel_radius`` [m],
 ``bushing_stiffness`` [N m/rad] and ``bushing_damping`` [N m s/rad] (skateboard),
 ``base_payload`` [kg], ``motor_torque_limit`` (scale only) and ``joint_damping``
 [N m s/rad] (``joint``, default all); units, ranges and how each applies are in
 :mod:`ridempc.sim.knobs`.
+
+Terrain (slopes, steps, stairs, rough patches, raised strips, boxes) is a list of
+``[[terrain]]`` tables, described in :mod:`ridempc.scenarios.terrain`.
 """
 
 from __future__ import annotations

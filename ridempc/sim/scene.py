@@ -11,6 +11,7 @@ can change their friction.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -21,7 +22,9 @@ from ridempc.errors import ConfigError
 from ridempc.mjcf import STIFF_CONTACT, add_imu_sensors
 from ridempc.robots.robot import Robot
 from ridempc.sim.contact_pairs import add_surface_pairs, collision_geoms
-from ridempc.sim.terrain import TerrainLayout, add_terrain
+
+if TYPE_CHECKING:  # the terrain reads the scenarios, whose knobs read this module
+    from ridempc.sim.terrain import TerrainLayout
 
 __all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
 
@@ -234,7 +237,11 @@ def build_scene(
     for key in list(spec.keys):
         spec.delete(key)
     _add_world(spec, physics_hz)
-    terrain_names = add_terrain(spec, terrain) if terrain is not None else []
+    terrain_names = []
+    if terrain is not None:
+        from ridempc.sim.terrain import add_terrain
+
+        terrain_names = add_terrain(spec, terrain)
     if robot is not None:
         add_imu_sensors(spec, robot.params.imu_site)
         rider_names = [robot.params.base_body]
