@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from ridempc.boards import load_board
+from ridempc.cli import main
 from ridempc.errors import ConfigError
 from ridempc.robots import load_robot
 from ridempc.run import RideRequest, check_request
@@ -192,3 +193,27 @@ def test_level_after_is_the_time_from_the_crossing_to_the_last_tilt(tmp_path: Pa
     assert step["level_after_s"] == pytest.approx(0.35, abs=0.011)
     quaternion[-1, 0] = [np.cos(0.1), 0.0, np.sin(0.1), 0.0]  # tilted at the end: never level
     assert step_levelling(log, scenario)["steps"][0]["level_after_s"] is None
+
+
+@pytest.mark.parametrize(
+    ("body", "words"),
+    [
+        (STEP.replace("height = 0.05", "height_radii = 2.5"), "terrain.0.height_radii"),
+        (STEP.replace("2.0", "4.0") + SLOPE, "terrain.1: slope overlaps terrain.0"),
+    ],
+)
+def test_the_cli_refuses_bad_terrain_in_one_line_before_anything_is_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], body: str, words: str
+) -> None:
+    path = tmp_path / "s.toml"
+    path.write_text(HEAD + body)
+    out = tmp_path / "out"
+    code = main(
+        ["sim", "--robot", "cassie", "--board", "hovershoes", "--controller", "pd",
+         "--scenario", str(path), "--out", str(out), "--no-plots"]
+    )  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert err.startswith(f"ridempc: error: {path}:") and "\n" not in err
+    assert words in err
+    assert not out.exists() or not any(out.iterdir())
