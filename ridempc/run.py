@@ -27,9 +27,11 @@ from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, load_scenario_file, resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.levelling import step_levelling
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import RunResult, Simulation
+from ridempc.sim.terrain import lay_out
 from ridempc.units import MAX_DURATION, MIN_DURATION
 
 if TYPE_CHECKING:
@@ -162,6 +164,15 @@ def check_request(request: RideRequest) -> CheckedRide:
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
 
+    terrain = None
+    if scenario.terrain:
+        radius = getattr(board.params, "wheel_radius", None) if board is not None else None
+        try:
+            terrain = lay_out(scenario.terrain, radius, board_name)
+        except ConfigError as exc:
+            given = str(request.scenario)
+            path = isinstance(request.scenario, Path) or given.endswith(".toml") or "/" in given
+            raise ConfigError(f"{given if path else f'scenario {scenario.name!r}'}: {exc}") from exc
     scene = build_scene(
         robot,
         request.physics_hz,
@@ -169,6 +180,7 @@ def check_request(request: RideRequest) -> CheckedRide:
         dead_weight=dead_weight,
         foot_offset=scenario.foot_offset,
         platform_offsets=scenario.platform_offsets,
+        terrain=terrain,
     )
     height = float(scene.data.xpos[scene.base_body, 2])
     frame_callbacks: list[Callable[[Any, Any], None]] = []
@@ -356,6 +368,7 @@ def _summary(
         or (controller is not None and controller.uses_ground_truth),
         "rider_mass_kg": round(scene.rider_mass, 4),
         **run_metrics(result, scenario, robot),
+        **step_levelling(result.log, scenario),
         **(controller.summary() if controller is not None else {}),
         "files": files,
     }

@@ -723,6 +723,7 @@ class MpcRider(Controller):
             heading=self._follows_heading,
             yaw_rate=yaw_rate,
         )
+        self.map.follow_ground(estimate)
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
         """Where each foot is over this MPC step, from the schedule's contacts: on the ground

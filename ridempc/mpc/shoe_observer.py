@@ -32,6 +32,10 @@ the firmware does beyond :math:`c_4\\theta`):
 :math:`x_P` the shoe's forward axis, :math:`m_s` [kg] the bare shoe. Without it the MPC held
 its shoes level at 0.5 m/s and the speed sagged to 0.35 m/s.
 
+**Slopes.** The ground's slope under each shoe, estimated from its velocity
+(:mod:`ridempc.mpc.slope`), adds its pull :math:`G = -(m_s g + N)\\sin\\hat\\alpha` to
+:math:`D` at once; the fit below finds only the rest.
+
 **Fitting.** The pitch, the speed, the torque, the push and the load pass through the same
 critically damped second-order low-pass at ``FILTER_HZ``, whose states give the filtered
 angle, speed and their rates without differentiating noise. The residuals of the two
@@ -70,6 +74,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.estimation.state import BoardEstimate, EstimatedState
+from ridempc.mpc.slope import SlopeEstimator
 from ridempc.mpc.state_map import forward_speed
 from ridempc.trajopt.platforms import HovershoesBoard
 
@@ -140,6 +145,7 @@ class ShoeObserver:
         self._weight = np.zeros(n)  # [-] sum of w
         self.offsets = np.zeros(n)  # [m] d per platform
         self.drag = np.zeros(n)  # [N] D per platform
+        self.slopes = SlopeEstimator(n)  # the ground's slope under each shoe
 
     def update(
         self,
@@ -183,6 +189,7 @@ class ShoeObserver:
         theta, theta_dot, theta_ddot = y[:n], dy[:n], ddy[:n]
         accel = dy[n : 2 * n]
         u, pushed, weight = y[2 * n : 3 * n], y[3 * n : 4 * n], y[4 * n :]
+        slopes = self.slopes.update(estimate.time, boards)
         if estimate.time - self._start < self.warm_up:
             return
         forget = math.exp(-dt / self.memory)
@@ -191,16 +198,17 @@ class ShoeObserver:
             self._load[k] *= forget
             self._force[k] *= forget
             self._weight[k] *= forget
+            uphill = self.slopes.gravity_drag(slopes[k], self.shoe_mass, weight[k])
             if weight[k] > MIN_LOAD:
                 balance = p.J_theta * theta_ddot[k] + p.c2 * theta_dot[k] + p.c1 * theta[k] - u[k]
-                residual = self.shoe_mass * accel[k] - p.c4 * theta[k] - pushed[k]
+                residual = self.shoe_mass * accel[k] - p.c4 * theta[k] - pushed[k] - uphill
                 self._moment[k] += weight[k] * balance
                 self._load[k] += weight[k] * weight[k]
                 self._force[k] += residual
                 self._weight[k] += 1.0
             if self._load[k] > 0.0:
                 self.offsets[k] = min(max(self._moment[k] / self._load[k], -LIMIT), LIMIT)
-                self.drag[k] = self._force[k] / self._weight[k]
+                self.drag[k] = self._force[k] / self._weight[k] + uphill
 
     def speed_drift(self, c: Array, dt: float, speeds: Sequence[int]) -> Array:
         """The MPC's affine terms ``c`` (N x nx) with each shoe's drag in its speed equation,

@@ -46,6 +46,7 @@ from ridempc.robots.pinocchio_model import PinocchioRobot
 
 __all__ = [
     "ALONG_SLACK",
+    "GROUND_FILTER_S",
     "HEADING_FILTER_S",
     "HEADING_SPEED",
     "RATE_FILTER_HZ",
@@ -59,6 +60,9 @@ RATE_FILTER_HZ: float = 15.0  # [Hz] on the differentiated platform angles
 HEADING_SPEED: float = 0.5  # [m/s] below this a board's direction of travel is not its heading
 HEADING_FILTER_S: float = 0.3  # [s] time constant of the followed heading
 ALONG_SLACK: float = 0.1  # [m] the board's offset along the reference's line is kept within
+# [s] the followed ground's lag: a Hovershoe's 4 cm drop off a step is followed within a tenth
+# of a second, its 4 Hz pitch's bobbing of the decks averaged out
+GROUND_FILTER_S: float = 0.1
 
 
 def _along(velocity: Array, yaw: float) -> float:
@@ -80,10 +84,13 @@ class PlanarFrame:
     Attributes:
         yaw: :math:`\\Delta\\psi` [rad].
         offset: :math:`\\Delta p` [m] (x, y).
+        height: :math:`\\Delta p_z` [m], the ground's rise since the start under the
+            platforms (:meth:`StateMap.follow_ground`).
     """
 
     yaw: float = 0.0
     offset: tuple[float, float] = (0.0, 0.0)
+    height: float = 0.0
 
     def _rotation(self, sign: float) -> Array:
         c, s = math.cos(self.yaw), math.sin(sign * self.yaw)
@@ -91,10 +98,14 @@ class PlanarFrame:
 
     @classmethod
     def through(
-        cls, yaw: float, library: Sequence[float] | Array, world: Sequence[float] | Array
+        cls,
+        yaw: float,
+        library: Sequence[float] | Array,
+        world: Sequence[float] | Array,
+        height: float = 0.0,
     ) -> PlanarFrame:
         """The frame turned by ``yaw`` [rad] that puts the library point ``library`` on the
-        world point ``world`` [m] (their x and y)."""
+        world point ``world`` [m] (their x and y), ``height`` [m] above the library's."""
         c, s = math.cos(yaw), math.sin(yaw)
         return cls(
             yaw,
@@ -102,6 +113,7 @@ class PlanarFrame:
                 float(world[0] - (c * library[0] - s * library[1])),
                 float(world[1] - (s * library[0] + c * library[1])),
             ),
+            height,
         )
 
     def rotation(self) -> Array:
@@ -109,14 +121,16 @@ class PlanarFrame:
         return self._rotation(1.0)
 
     def point_to_library(self, p: Array) -> Array:
-        shifted = np.asarray(p, dtype=float) - np.array([*self.offset, 0.0])
+        shifted = np.asarray(p, dtype=float) - np.array([*self.offset, self.height])
         return self._rotation(-1.0).dot(shifted)
 
     def vector_to_library(self, v: Array) -> Array:
         return self._rotation(-1.0).dot(np.asarray(v, dtype=float))
 
     def point_to_world(self, p: Array) -> Array:
-        return self._rotation(1.0).dot(np.asarray(p, dtype=float)) + np.array([*self.offset, 0.0])
+        return self._rotation(1.0).dot(np.asarray(p, dtype=float)) + np.array(
+            [*self.offset, self.height]
+        )
 
     def vector_to_world(self, v: Array) -> Array:
         return self._rotation(1.0).dot(np.asarray(v, dtype=float))
@@ -166,6 +180,9 @@ class StateMap:
         self.frame = PlanarFrame()
         self._rates: dict[str, _AngleRate] = {}
         self._heading_time = 0.0
+        self._deck_start: float | None = None  # [m] the platforms' first height
+        self._ground_time = 0.0
+        self.ground_rate = 0.0  # [m/s] the followed ground's rise rate
         self._fill = [self._filler(name) for name in self.names]
 
     def _filler(self, name: str) -> tuple[str, int | str]:
@@ -188,6 +205,9 @@ class StateMap:
 
     def reset(self) -> None:
         self.frame = PlanarFrame()
+        self._deck_start = None
+        self._ground_time = 0.0
+        self.ground_rate = 0.0
         self._rates = {}
         self._heading_time = 0.0
 
@@ -239,6 +259,7 @@ class StateMap:
         angles = (roll, pitch, wrap_angle(yaw - self.frame.yaw))
         com_lib = self.frame.point_to_library(com)
         velocity_lib = self.frame.vector_to_library(com_velocity)
+        velocity_lib[2] -= self.ground_rate
         x = np.empty(len(self.names))
         origins: dict[int, Array] = {}
         for i, (kind, key) in enumerate(self._fill):
@@ -276,7 +297,9 @@ class StateMap:
         else:
             yaw_world, position = board.yaw, board.position
         x_ref, y_ref, yaw_ref = board_pose
-        self.frame = PlanarFrame.through(wrap_angle(yaw_world - yaw_ref), (x_ref, y_ref), position)
+        self.frame = PlanarFrame.through(
+            wrap_angle(yaw_world - yaw_ref), (x_ref, y_ref), position, self.frame.height
+        )
 
     def follow_sideways(
         self,
@@ -370,7 +393,7 @@ class StateMap:
             carried = self.frame.yaw + yaw_rate * step
             yaw = carried + share * wrap_angle(wanted - carried)
             kept = self.frame.point_to_library(board.position)
-            self.frame = PlanarFrame.through(yaw, kept, board.position)
+            self.frame = PlanarFrame.through(yaw, kept, board.position, self.frame.height)
         self._heading_time = estimate.time
         p_lib = self.frame.point_to_library(board.position)
         normal = np.array([-math.sin(yaw_ref), math.cos(yaw_ref), 0.0])
@@ -386,5 +409,33 @@ class StateMap:
             moved[:2] += excess * tangent
         shift = self.frame.vector_to_world(moved)
         offset = (self.frame.offset[0] + float(shift[0]), self.frame.offset[1] + float(shift[1]))
-        self.frame = PlanarFrame(self.frame.yaw, offset)
+        self.frame = PlanarFrame(self.frame.yaw, offset, self.frame.height)
         return error
+
+    def follow_ground(self, estimate: EstimatedState) -> float:
+        """Raise the frame with the ground under the platforms: the library's rides are on
+        level ground, and a rider kept at her starting height down a slope or a flight of
+        steps stretched her legs after the shoes (stairs-79-93-93 fell at the third step).
+
+        The rise is the platforms' mean estimated height (the feet's, from the IMU and the
+        kinematics: no height map) over the first one seen, low-passed over
+        ``GROUND_FILTER_S``; its rate, the platforms' mean vertical velocity low-passed the
+        same way, comes off the centre of mass's (:meth:`state`), so that a rider rolling
+        down a slope is not asked to stop sinking with it. Without a board estimate nothing
+        changes.
+
+        Returns:
+            The frame's height :math:`\\Delta p_z` [m].
+        """
+        if not estimate.boards:
+            return self.frame.height
+        deck = sum(float(b.position[2]) for b in estimate.boards) / len(estimate.boards)
+        if self._deck_start is None:
+            self._deck_start, self._ground_time = deck, estimate.time
+        share = min(1.0, max(0.0, estimate.time - self._ground_time) / GROUND_FILTER_S)
+        self._ground_time = estimate.time
+        height = self.frame.height + share * (deck - self._deck_start - self.frame.height)
+        sinking = sum(float(b.velocity[2]) for b in estimate.boards) / len(estimate.boards)
+        self.ground_rate += share * (sinking - self.ground_rate)
+        self.frame = PlanarFrame(self.frame.yaw, self.frame.offset, height)
+        return height

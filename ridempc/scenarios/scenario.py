@@ -47,6 +47,9 @@ The other knobs: ``tyre_friction``, ``deck_friction`` [-], ``wheel_radius`` [m],
 ``base_payload`` [kg], ``motor_torque_limit`` (scale only) and ``joint_damping``
 [N m s/rad] (``joint``, default all); units, ranges and how each applies are in
 :mod:`ridempc.sim.knobs`.
+
+Terrain (slopes, steps, stairs, rough patches, raised strips, boxes) is a list of
+``[[terrain]]`` tables, described in :mod:`ridempc.scenarios.terrain`.
 """
 
 from __future__ import annotations
@@ -59,6 +62,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from ridempc.scenarios.terrain import TerrainItem, check_terrain
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
@@ -273,6 +277,12 @@ class Scenario(_Frozen):
     changes: tuple[ParameterChange, ...] = ()
     noise: SensorNoise = SensorNoise()
     push_off: PushOff | None = None
+    terrain: tuple[TerrainItem, ...] = ()  # [[terrain]]: see ridempc.scenarios.terrain
+
+    @model_validator(mode="after")
+    def _terrain_fits(self) -> Scenario:
+        check_terrain(self.terrain)
+        return self
 
     @model_validator(mode="after")
     def _ordered(self) -> Scenario:

@@ -1,11 +1,15 @@
 """Fall detection, from the judge's true-state view (never shown to controllers).
 
-The rider fell when its base is below ``fall_height`` [m] over its starting support, or when
+The rider fell when its base is below ``fall_height`` [m] over its support, or when
 one of its bodies that is not a foot touches the ground (for a dead weight: any of it).
 The board fell when one of its bodies other than the wheels touches the ground. On a board,
 a rider's foot on the ground is a fall too (it stepped off), unless the ride puts a foot
 there on purpose (a skateboard push-off, ``feet_on_ground``); even then, every foot on the
 ground at once is stepping off.
+
+On terrain the support is the starting one moved with the ground under the rider: the
+lowest of the terrain's heights under the base and under each board root (a step down
+passed by the base and not yet by the shoes does not count as a fall).
 """
 
 from __future__ import annotations
@@ -36,6 +40,8 @@ class FallDetector:
         self._forbidden = {b: "rider" for b in scene.rider_bodies - allowed} | {
             b: "board" for b in scene.board_bodies - scene.board_ground_bodies
         }
+        self._terrain = scene.terrain
+        self._roots = (self._base, *scene.board_roots)
         self._names = {
             b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in self._forbidden
         }
@@ -45,12 +51,19 @@ class FallDetector:
         self._is_forbidden = np.zeros(model.nbody, dtype=bool)
         self._is_forbidden[list(self._forbidden)] = True
 
+    def _ground_under_rider(self, data: mujoco.MjData) -> float:
+        """Height of the terrain under the rider [m] (0: flat ground, the start's)."""
+        if self._terrain is None:
+            return 0.0
+        return min(self._terrain.height_at(*data.xpos[b, :2]) for b in self._roots)
+
     def check(self, model: mujoco.MjModel, data: mujoco.MjData) -> str | None:
         """The reason of a fall now, or None."""
         if self._fall_height is not None:
             height = data.xpos[self._base, 2]
-            if height < self._fall_height:
-                return f"base height {height:.3f} m below {self._fall_height:.3f} m"
+            limit = self._fall_height + self._ground_under_rider(data)
+            if height < limit:
+                return f"base height {height:.3f} m below {limit:.3f} m"
         geoms = data.contact.geom[: data.ncon]
         # per contact, the body of each geom touching the ground: (g1 on ground -> g2's, then
         # g2 on ground -> g1's), contact by contact

@@ -34,10 +34,10 @@ from ridempc.rotations import euler_of_quaternions
 from ridempc.scenarios.scenario import PUSH_OFF_WINDOW, Scenario
 from ridempc.sim.simulation import RunResult
 
-__all__ = ["board_roll", "run_metrics"]
+__all__ = ["board_roll", "board_tilt", "run_metrics"]
 
 
-def _tilt(quaternions: np.ndarray) -> np.ndarray:
+def board_tilt(quaternions: np.ndarray) -> np.ndarray:
     """Angle between a body's z axis and the world's [rad], for (w, x, y, z) quaternions."""
     x, y = quaternions[..., 1], quaternions[..., 2]
     return np.arccos(np.clip(1.0 - 2.0 * (x**2 + y**2), -1.0, 1.0))
@@ -112,7 +112,7 @@ def run_metrics(result: RunResult, scenario: Scenario, robot: Robot | None) -> d
         wanted = spacing[0] + 2.0 * log["command_lateral_offset"]
         metrics["foot_spacing_rmse"] = _rmse(spacing[window] - wanted[window])
     if "board_quaternion" in log:
-        metrics["board_max_tilt"] = float(np.max(_tilt(log["board_quaternion"])))
+        metrics["board_max_tilt"] = float(np.max(board_tilt(log["board_quaternion"])))
         metrics["board_max_speed"] = float(
             np.max(np.linalg.norm(log["board_velocity"][..., :2], axis=-1))
         )

@@ -11,6 +11,7 @@ can change their friction.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -21,6 +22,9 @@ from ridempc.errors import ConfigError
 from ridempc.mjcf import STIFF_CONTACT, add_imu_sensors
 from ridempc.robots.robot import Robot
 from ridempc.sim.contact_pairs import add_surface_pairs, collision_geoms
+
+if TYPE_CHECKING:  # the terrain reads the scenarios, whose knobs read this module
+    from ridempc.sim.terrain import TerrainLayout
 
 __all__ = ["BOARD_PREFIX", "FOOT_CLEARANCE", "Scene", "build_scene"]
 
@@ -61,6 +65,7 @@ class Scene:
         deck_geoms: Collision geom ids of the board's platforms (where the rider stands).
         support_height: Height of the rider's support at the start [m] (platform top or 0).
         initial_qpos: The settled initial configuration.
+        terrain: The scenario's terrain (the judge's ground heights), or None: flat ground.
     """
 
     model: mujoco.MjModel
@@ -82,6 +87,7 @@ class Scene:
     support_height: float
     initial_qpos: NDArray[np.float64]
     deck_geoms: frozenset[int] = frozenset()
+    terrain: TerrainLayout | None = None
 
     def reset(self) -> None:
         mujoco.mj_resetData(self.model, self.data)
@@ -207,6 +213,7 @@ def build_scene(
     dead_weight: float | None = None,
     foot_offset: tuple[float, float] = (0.0, 0.0),
     platform_offsets: tuple[tuple[float, float], ...] = (),
+    terrain: TerrainLayout | None = None,
 ) -> Scene:
     """Compile a rider on a board (or on flat ground) in a settled initial state.
 
@@ -218,6 +225,7 @@ def build_scene(
         foot_offset: Feet (or weight) offset from the platform centre, (x, y) [m].
         platform_offsets: Per independent platform, a further shift of that platform, (x, y)
             [m] (Hovershoes started staggered).
+        terrain: The scenario's terrain (:func:`ridempc.sim.terrain.lay_out`), or None.
 
     The rider's feet go over the board's platform site(s): a rigid board puts the centroid
     of all feet over its one platform; independent platforms (Hovershoes) each move under
@@ -229,6 +237,11 @@ def build_scene(
     for key in list(spec.keys):
         spec.delete(key)
     _add_world(spec, physics_hz)
+    terrain_names = []
+    if terrain is not None:
+        from ridempc.sim.terrain import add_terrain
+
+        terrain_names = add_terrain(spec, terrain)
     if robot is not None:
         add_imu_sensors(spec, robot.params.imu_site)
         rider_names = [robot.params.base_body]
@@ -241,8 +254,11 @@ def build_scene(
         spec.attach(board.spec(), prefix=BOARD_PREFIX, frame=spec.worldbody.add_frame())
     model = spec.compile()
     floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+    ground = [floor] + [
+        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in terrain_names
+    ]
     decks = _deck_geoms(model, board)
-    model = add_surface_pairs(spec, model, [floor, *decks])  # for friction changes
+    model = add_surface_pairs(spec, model, [*ground, *decks])  # for friction changes
     data = mujoco.MjData(model)
 
     def body(name: str) -> int:
@@ -347,10 +363,11 @@ def build_scene(
         board_bodies=board_bodies,
         board_roots=board_roots,
         board_ground_bodies=board_ground,
-        ground_geoms=frozenset({floor}),
+        ground_geoms=frozenset(ground),
         deck_geoms=frozenset(decks),
         support_height=support,
         initial_qpos=qpos,
+        terrain=terrain,
     )
     scene.reset()
     return scene
