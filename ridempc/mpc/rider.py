@@ -19,7 +19,8 @@ Every 2 ms (500 Hz) the rider
    coasts: the steady ride is slowed to the board's speed,
    :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`); a commanded deck roll
    replaces the reference's roll, and on the skateboard turns the reference's heading at
-   the rate the roll steers (eq. 14); on the Segway, whose knee bar the plan cannot push,
+   the rate the roll steers (eq. 14), a commanded yaw rate adding the roll that steers it
+   (:mod:`ridempc.boards.skateboard.steering`); on the Segway, whose knee bar the plan cannot push,
    the rider crouches into the robot's riding keyframe and leans into the bar: a yaw-rate
    loop moves the reference's centre of mass sideways, and riding, the reference's
    headings and the heading the frame follows turn at the commanded rate and the frame's
@@ -83,6 +84,7 @@ from ridempc.boards.board import Board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.skateboard.parameters import SkateboardParameters
 from ridempc.boards.skateboard.reduced import yaw_rate
+from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -331,6 +333,8 @@ class MpcRider(Controller):
             else None
         )
         self._steer_gain = deck.steer_gain if deck is not None else None
+        # a yaw-rate command steered by the deck's roll, eq. (14) inverted
+        self.roll_steering = RollSteering(gain=deck.steer_gain) if deck is not None else None
         index, gain = self.layout.names, self.pair.roll_observer
         self.roll_observer = (
             RollObserver(index["board_roll"], index["board_roll_rate"], deck, gain)
@@ -483,6 +487,7 @@ class MpcRider(Controller):
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
+        roll = roll + self._steering_roll(command, now, speed)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
@@ -749,6 +754,20 @@ class MpcRider(Controller):
         if previous is not None and now > previous[0]:
             rate = (command.roll - previous[1]) / (now - previous[0])
         return np.asarray(command.roll + rate * (times - now), dtype=float)
+
+    def _steering_roll(self, command: Command, now: float, speed: float) -> Array:
+        """The deck roll that steers the commanded yaw rate at the horizon's nodes [rad]
+        (:class:`~ridempc.boards.skateboard.steering.RollSteering`, at the board's speed
+        :math:`v` [m/s]), each read the pair's ``roll_lead`` ahead as the commanded roll
+        is; zero on a board that does not steer by its roll."""
+        settings = self.mpc.settings
+        if self.roll_steering is None:
+            return np.zeros(settings.horizon + 1)
+        times = now + self.pair.roll_lead + settings.dt * np.arange(settings.horizon + 1)
+        rates = self._planned("yaw_rate", times)
+        if rates is None:
+            rates = np.full(len(times), float(command.yaw_rate))
+        return np.array([self.roll_steering.roll(float(w), speed) for w in rates])
 
     def _roll_turn(self, roll: Array, speed: float) -> Array:
         """The turn a commanded deck roll steers, over the horizon's steps [rad/s]: on the
