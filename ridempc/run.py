@@ -18,14 +18,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ridempc.boards import NO_BOARD, load_board
+from ridempc.boards.steering import check_steering
 from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
 from ridempc.controllers.base import Controller
+from ridempc.controllers.path_following import follow_path
 from ridempc.errors import ConfigError, WriteFailed
 from ridempc.io import atomic_write_json, atomic_write_npz
 from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, load_scenario_file, resolve_scenario
+from ridempc.scenarios.path_metrics import path_metrics
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
@@ -156,6 +159,9 @@ def check_request(request: RideRequest) -> CheckedRide:
             f"allowed: none, or one per independent platform (board '{board_name}' has "
             f"{platforms if platforms > 1 else 'none'})"
         )
+    check_steering(scenario, board)
+    if scenario.path is not None and controller is not None:  # the rider steers onto it
+        controller = follow_path(controller, scenario.path, board)
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
 
@@ -353,6 +359,7 @@ def _summary(
         or (controller is not None and controller.uses_ground_truth),
         "rider_mass_kg": round(scene.rider_mass, 4),
         **run_metrics(result, scenario, robot),
+        **path_metrics(result.log, scenario),
         **(controller.summary() if controller is not None else {}),
         "files": files,
     }

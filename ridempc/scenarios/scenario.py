@@ -59,6 +59,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from ridempc.scenarios.path import PathCommand
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
 from ridempc.tomlfile import load_checked
@@ -273,6 +274,7 @@ class Scenario(_Frozen):
     changes: tuple[ParameterChange, ...] = ()
     noise: SensorNoise = SensorNoise()
     push_off: PushOff | None = None
+    path: PathCommand | None = None  # a path to follow (ridempc.scenarios.path)
 
     @model_validator(mode="after")
     def _ordered(self) -> Scenario:
@@ -294,6 +296,8 @@ class Scenario(_Frozen):
         times += [(f"changes.{i}.t", c.t) for i, c in enumerate(self.changes)]
         if self.push_off is not None:
             times.append(("push_off.judged_at", self.push_off.judged_at))
+        if self.path is not None:
+            times.append(("path.start", self.path.start))
         for where, t in times:
             if t > self.duration or (where == "metrics_start" and t >= self.duration):
                 raise ValueError(
