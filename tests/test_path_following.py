@@ -3,6 +3,7 @@ judge's figures, and steering commands a board cannot turn refused before a ride
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -85,6 +86,7 @@ def test_path_metrics_from_a_log() -> None:
     n = len(xy)
     log = {"time": np.linspace(0.0, 10.0, n), "base_position": np.column_stack([xy, np.zeros(n)])}
     figures = path_metrics(log, scenario)
+    json.dumps(figures, allow_nan=False)  # summary.json takes them as they are
     assert figures["gates"] == 3 and figures["gates_passed"] == 3
     assert 0.05 < figures["cross_track_rmse"] <= 0.1 + 1e-6
     assert path_metrics(log, Scenario(name="q", duration=10.0)) == {}

@@ -30,7 +30,7 @@ def gates_passed(path: SlalomPath, xy: np.ndarray) -> int:
             k = crossed[0]
             share = (gate[0] - xy[k, 0]) / (xy[k + 1, 0] - xy[k, 0])
             y = xy[k, 1] + share * (xy[k + 1, 1] - xy[k, 1])
-            passed += abs(y - gate[1]) <= 0.5 * path.gate_width
+            passed += int(abs(y - gate[1]) <= 0.5 * path.gate_width)
     return passed
 
 
@@ -47,6 +47,6 @@ def path_metrics(log: dict[str, np.ndarray], scenario: Scenario) -> dict[str, An
         "max_cross_track": float(np.max(np.abs(cross))) if cross.size else None,
     }
     if isinstance(path, SlalomPath):
-        out["gates"] = path.gates
-        out["gates_passed"] = gates_passed(path, xy)
+        out["gates"] = int(path.gates)
+        out["gates_passed"] = int(gates_passed(path, xy))
     return out
