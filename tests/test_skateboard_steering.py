@@ -100,7 +100,7 @@ def test_the_mpc_rider_steers_a_planned_yaw_rate_by_the_deck_roll() -> None:
         build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard")), rider, scenario
     )
     settings, lead = rider.mpc.settings, rider.pair.roll_lead
-    now, speed = 7.9, 0.7  # the +0.2 rad/s step turns to -0.2 at 8.0 s
+    now, speed = 7.6, 0.7  # the +0.2 rad/s step turns to -0.2 at 7.7 s
     times = now + lead + settings.dt * np.arange(settings.horizon + 1)
     wanted = np.array([scenario.command_at(float(t)).yaw_rate for t in times])
     assert wanted[0] == 0.2 and wanted[-1] == -0.2

@@ -17,7 +17,9 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
-   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`); a commanded deck roll
+   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`, and once it has slowed below
+   the command it pushes again from the rolling board, the library's ``repush``,
+   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.repush`); a commanded deck roll
    replaces the reference's roll, and on the skateboard turns the reference's heading at
    the rate the roll steers (eq. 14), a commanded yaw rate adding the roll that steers it
    (:mod:`ridempc.boards.skateboard.steering`); on the Segway, whose knee bar the plan cannot push,
@@ -97,6 +99,7 @@ from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
     HOLD,
+    REPUSH,
     YAW_RATE_SUFFIXES,
     Manoeuvre,
     ManoeuvreSelector,
@@ -472,6 +475,8 @@ class MpcRider(Controller):
         wanted = self.selector.select(
             self._speed_command(command, now), self.manoeuvre, now, rider_speed
         )
+        if wanted is self.manoeuvre and self._coasting(self.manoeuvre.reference_time(now)):
+            wanted = self.selector.repush(command, wanted, now, speed)  # slowed: push again
         if wanted is not self.manoeuvre:
             self.mpc.retarget(wanted.library_kind, wanted.target)
             reference = self.mpc.reference
@@ -487,10 +492,11 @@ class MpcRider(Controller):
             self._anchor(estimate, now)
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
-        roll = roll + self._steering_roll(command, now, speed)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
+        if balancing:  # steered on four legs; a push goes straight on its three
+            roll = roll + self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
@@ -688,7 +694,7 @@ class MpcRider(Controller):
         an ``accelerate`` on a board it drives only by pushing off."""
         return (
             self.selector.coasts
-            and self.manoeuvre.kind == "accelerate"
+            and self.manoeuvre.kind in ("accelerate", REPUSH)
             and t_ref >= float(self.mpc.reference.times[-1])
         )
 

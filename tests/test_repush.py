@@ -1,0 +1,73 @@
+"""Pushing the skateboard again while it rolls: the rolling-start schedule, state and
+problem (``repush`` entries), and the rider choosing to push when the board has slowed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ridempc.errors import ConfigError
+from ridempc.mpc.manoeuvre import REPUSH, REPUSH_BAND, Manoeuvre, ManoeuvreSelector
+from ridempc.scenarios.scenario import Command
+from ridempc.trajopt.pairs import EntrySpec
+from ridempc.trajopt.schedule import push_schedule
+from ridempc.trajopt.skate_pair import REPUSH_GAIN, repush_entry, skate_models
+from ridempc.trajopt.skate_problem import initial_skate_state
+from ridempc.trajopt.skateboard import BOARD_STATE
+
+
+def test_a_rolling_start_needs_the_strides_of_the_speed_it_gains() -> None:
+    from_rest = push_schedule(0.7, 4, 2)
+    rolling = push_schedule(0.7, 4, 2, start_speed=0.5)
+    pushes = [p for p in rolling.phases if p.mode == "push"]
+    assert len(pushes) == 2 < len([p for p in from_rest.phases if p.mode == "push"])
+    assert rolling.phases[0].mode == rolling.phases[-1].mode == "four-leg"
+
+
+def test_the_rolling_start_state_rides_with_the_board() -> None:
+    robot, board = skate_models()
+    rest, places = initial_skate_state(robot, board)
+    rolling, same_places = initial_skate_state(robot, board, 0.5)
+    nr = 12 + robot.n_joints
+    assert rolling[6] == 0.5 and rolling[nr + BOARD_STATE.index("board_v")] == 0.5
+    changed = np.flatnonzero(rolling != rest)
+    assert set(changed) == {6, nr + BOARD_STATE.index("board_v")}
+    np.testing.assert_array_equal(places, same_places)
+
+
+def test_a_repush_problem_starts_rolling_and_ends_at_its_target() -> None:
+    """Built, not solved (IPOPT takes 40 s): node 0 fixed at the rolling start, the last
+    node's speed at the target, the speed reference ramped from the one to the other."""
+    from ridempc.trajopt.skate_pair import PAIR
+
+    spec = repush_entry(0.7)
+    assert spec.name == "repush-0.70" and spec.options["start_speed"] == pytest.approx(0.5)
+    PAIR.check(spec)
+    problem = PAIR.build(spec)
+    assert problem.metadata["kind"] == REPUSH
+    assert problem.metadata["options"]["start_speed"] == pytest.approx(0.5)
+    names = list(problem.state_names)
+    first = problem.lbw[: problem.nx] * problem.state_scale
+    assert first[names.index("board_v")] == pytest.approx(0.5)
+    assert first[names.index("vx")] == pytest.approx(0.5)
+    with pytest.raises(ConfigError, match="start_speed"):
+        PAIR.check(EntrySpec("repush", 0.7))  # a re-push from rest is an accelerate
+
+
+def test_the_rider_pushes_again_once_the_board_has_slowed() -> None:
+    selector = ManoeuvreSelector("cyberdog2", "skateboard")
+    assert REPUSH not in selector.targets  # the committed library pushes from rest only
+    selector.targets = {**selector.targets, REPUSH: (0.5, 0.7, 1.0)}
+    assert REPUSH_BAND == REPUSH_GAIN  # pushed when the board is at the entry's start
+    coasting = Manoeuvre("accelerate", 0.7, 0.5)
+    command = Command(velocity=0.7)
+    assert selector.repush(command, coasting, 9.0, 0.6) is coasting  # not slow enough yet
+    pushed = selector.repush(command, coasting, 9.0, 0.49)
+    assert (pushed.kind, pushed.target, pushed.start) == (REPUSH, 0.7, 9.0)
+    assert selector.repush(Command(velocity=0.0), coasting, 9.0, 0.2) is coasting  # rest
+    # a running re-push is kept while the command holds, and starts at its rolling start
+    # (its speed phase matched instead, a rider a little faster joined it mid-push)
+    assert selector.select(command, pushed, 9.5, 0.55) is pushed
+    times = np.linspace(0.0, 2.0, 5)
+    speeds = np.array([0.5, 0.45, 0.5, 0.6, 0.7])
+    assert ManoeuvreSelector.phase_start(times, speeds, 0.52, 9.0, REPUSH) == 9.0
