@@ -1,10 +1,12 @@
 """Following a commanded path: a cross-track-to-yaw-rate law around any rider that turns.
 
 The rider reads its own pose (the visual-inertial odometry's position, heading and
-velocity, carried over its latency at its velocity) and, with :math:`e` its cross-track
-error (positive left of the path), :math:`\\theta = \\psi - \\psi_p` its heading against the
-path's, :math:`\\kappa_p` the path's curvature read ``preview`` [s] ahead (the lag of a
-board that turns through a roll) and :math:`v` its forward speed, asks for the yaw rate
+velocity, carried over its latency at its velocity), in the path frame laid at its pose
+when it starts following (:class:`~ridempc.scenarios.path.PathFrame`), and, with
+:math:`e` its cross-track error (positive left of the path), :math:`\\theta = \\psi -
+\\psi_p` its heading against the path's, :math:`\\kappa_p` the path's curvature read
+``preview`` [s] ahead (the lag of a board that turns through a roll) and :math:`v` its
+forward speed, asks for the yaw rate
 
 .. math:: \\omega^* = v \\left(\\kappa_p - \\frac{e}{D^2} - \\frac{2 \\sin\\theta}{D}\\right)
 
@@ -30,7 +32,7 @@ import numpy as np
 from ridempc.boards.board import Board
 from ridempc.boards.steering import steering_limits
 from ridempc.controllers.base import Controller
-from ridempc.scenarios.path import CirclePath, PathGeometry, SlalomPath
+from ridempc.scenarios.path import CirclePath, PathFrame, PathGeometry, SlalomPath
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -92,6 +94,7 @@ class PathFollowing(Controller):
         self.distance = distance
         self.preview = preview
         self._index: int | None = None
+        self._frame: PathFrame | None = None  # the rider's pose at the path's start
         self._yaw_rate = 0.0
         self._timeline: Callable[[float], Command] | None = None
         self._diagnostics: dict[str, float] = {}
@@ -125,6 +128,10 @@ class PathFollowing(Controller):
         point = np.asarray(vio.position[:2], dtype=float) + lag * np.asarray(vio.velocity[:2])
         heading = vio.yaw + lag * vio.yaw_rate
         speed = math.cos(heading) * vio.velocity[0] + math.sin(heading) * vio.velocity[1]
+        if self._frame is None:
+            self._frame = PathFrame(point[0], point[1], heading)
+        point = self._frame.to_path(point)
+        heading = self._frame.heading_to_path(heading)
         geometry = self.geometry
         self._index = geometry.nearest(point, self._index)
         cross, path_heading = geometry.errors(point, self._index)
@@ -139,6 +146,7 @@ class PathFollowing(Controller):
 
     def reset(self, sensors: SensorPacket) -> None:
         self._index = None
+        self._frame = None
         self._yaw_rate = 0.0
         self.inner.reset(sensors)
 

@@ -1,7 +1,9 @@
 """A commanded path: the ``[path]`` table of a scenario, and its geometry.
 
-The path lies in the world's ground plane, where the ride starts at the origin heading
-along +x. Up to ``entry`` [m] it is the x axis (a push-off rides along it); from there
+The path lies in the ground plane, in the *path frame*: the rider's base as it was at
+``start`` [s], its ground point the origin, its heading the x axis (:class:`PathFrame`), so
+that the path starts where the rider is when she is asked to follow it, whatever a push-off
+before has left her. Up to ``entry`` [m] it is the x axis; from there
 
 - ``circle``: a circle of ``radius`` [m] tangent to the x axis at ``entry`` (positive:
   turning left), ridden for ``laps`` turns;
@@ -36,7 +38,7 @@ from pydantic import Field, model_validator
 
 from ridempc.units import CheckedModel, PositiveCount, Real, Time
 
-__all__ = ["CirclePath", "PathCommand", "PathGeometry", "SlalomPath"]
+__all__ = ["CirclePath", "PathCommand", "PathFrame", "PathGeometry", "SlalomPath"]
 
 Array = NDArray[np.float64]
 # [m] the polyline's spacing: a tenth of the cross-track target (0.15 m), so the nearest
@@ -127,6 +129,30 @@ class SlalomPath(CheckedModel):
 
 
 PathCommand = Annotated[CirclePath | SlalomPath, Field(discriminator="kind")]
+
+
+class PathFrame:
+    """The path frame in the world: origin ``(x, y)`` [m] and heading ``yaw`` [rad].
+
+    Args:
+        x: Origin along the world's x [m].
+        y: Origin along the world's y [m].
+        yaw: Heading of the path frame's x axis [rad].
+    """
+
+    def __init__(self, x: float, y: float, yaw: float) -> None:
+        self.origin = np.array([x, y], dtype=float)
+        self.yaw = float(yaw)
+        c, s = math.cos(yaw), math.sin(yaw)
+        self._rotation = np.array([[c, -s], [s, c]])
+
+    def to_path(self, points: Array) -> Array:
+        """World points [m] (..., 2) in the path frame."""
+        return (np.asarray(points, dtype=float) - self.origin) @ self._rotation
+
+    def heading_to_path(self, heading: float) -> float:
+        """A world heading [rad] in the path frame."""
+        return heading - self.yaw
 
 
 class PathGeometry:

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ridempc.scenarios.path import PathGeometry, SlalomPath
+from ridempc.scenarios.path import PathFrame, PathGeometry, SlalomPath
 from ridempc.scenarios.scenario import Scenario
 
 __all__ = ["gates_passed", "path_metrics"]
@@ -40,7 +40,12 @@ def path_metrics(log: dict[str, np.ndarray], scenario: Scenario) -> dict[str, An
     if path is None or not log:
         return {}
     window = log["time"] >= max(scenario.metrics_start, path.start)
-    xy = log["base_position"][:, :2]
+    first = int(np.searchsorted(log["time"], path.start))
+    if first >= len(log["time"]):
+        return {}
+    start = log["base_position"][first]
+    frame = PathFrame(float(start[0]), float(start[1]), float(log["yaw"][first]))
+    xy = frame.to_path(log["base_position"][:, :2])
     cross = PathGeometry(path).cross_track(xy)[window]
     out: dict[str, Any] = {
         "cross_track_rmse": float(np.sqrt(np.mean(cross**2))) if cross.size else None,
