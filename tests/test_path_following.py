@@ -149,3 +149,21 @@ def test_a_turn_the_skateboard_cannot_steer_exits_2(capsys, tmp_path, body, fiel
     assert err.startswith("ridempc: error:") and len(err.strip().splitlines()) == 1
     assert field in err and "allowed" in err
     assert not (tmp_path / "out").exists()  # nothing written
+
+
+def test_a_ride_with_a_path_follows_it_and_reports_the_cross_track() -> None:
+    """One second on the skateboard (the PD, standing: the board does not roll, so nothing
+    is steered): the rider is wrapped in the path follower and the summary carries the
+    path's figures."""
+    import ridempc
+
+    scenario = Scenario(
+        name="short-path",
+        duration=1.0,
+        commands=({"t": 0.0, "velocity": 0.7},),  # type: ignore[arg-type]
+        path=CirclePath(kind="circle", start=0.5, entry=1.0, radius=3.0),
+    )
+    summary = ridempc.ride("cyberdog2", "skateboard", "pd", scenario)
+    assert summary["status"] == "ok"
+    assert summary["cross_track_rmse"] < 0.02  # [m] standing on its start
+    assert "gates" not in summary

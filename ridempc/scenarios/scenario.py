@@ -18,6 +18,12 @@ non-physical values are refused with the field named). Example::
     force = [60.0, 0.0, 0.0]   # world frame [N]
     duration = 0.2             # [s]
 
+    [path]                     # a path to follow, see ridempc.scenarios.path
+    kind = "circle"            # or "slalom"
+    start = 6.5                # [s] laid from the rider's pose then
+    entry = 1.0                # [m] ahead of her
+    radius = 3.0               # [m], positive turning left
+
     [noise]                    # sensor noise overrides, see SensorNoise
     vio_latency = 0.05
 
