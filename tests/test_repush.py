@@ -71,3 +71,54 @@ def test_the_rider_pushes_again_once_the_board_has_slowed() -> None:
     times = np.linspace(0.0, 2.0, 5)
     speeds = np.array([0.5, 0.45, 0.5, 0.6, 0.7])
     assert ManoeuvreSelector.phase_start(times, speeds, 0.52, 9.0, REPUSH) == 9.0
+
+
+def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push() -> None:
+    """The offset between the rider and the re-push's first knot (the body 3 cm further
+    forward on the deck) is laid over the reference at the switch and gone by the first
+    push; the centre of mass's velocity row carries the blend's rate."""
+    from ridempc.mpc.manoeuvre import StateLayout
+    from ridempc.mpc.problem import MpcProblem
+    from ridempc.mpc.reference import select_reference
+    from ridempc.mpc.switch_blend import SwitchBlend, first_push_time
+
+    reference = select_reference("cyberdog2", "skateboard", "accelerate", 0.7)
+    layout = StateLayout.from_names(reference.state_names)
+    names = layout.names
+    push = first_push_time(reference)
+    assert 0.5 < push < reference.duration
+    x0 = reference.states_at(np.array([0.0]))[0].copy()
+    x0[names["com_x"]] += 0.05  # 3 cm ahead of the knot on a deck 2 cm further on
+    x0[names["board_x"]] += 0.02
+    x0[names["q_FL_knee"]] += 0.1
+    blend = SwitchBlend.at_switch(reference, layout, x0, 0.0)
+    assert blend.offsets[names["com_x"]] == pytest.approx(0.03)
+    assert blend.offsets[names["board_x"]] == 0.0
+    assert blend.offsets[names["q_FL_knee"]] == pytest.approx(0.1)
+    assert blend.duration == pytest.approx(push)
+    n, nx, nu, dt = 40, len(x0), 2, 0.05
+    window = reference.states_at(dt * np.arange(n + 1))
+    problem = MpcProblem(
+        initial_state=x0,
+        A=np.tile(np.eye(nx), (n, 1, 1)),
+        B=np.zeros((n, nx, nu)),
+        c=np.zeros((n, nx)),
+        state_reference=window,
+        input_reference=np.zeros((n, nu)),
+        state_weights=np.ones(nx),
+        input_weights=np.ones(nu),
+        input_lower=-np.ones((n, nu)),
+        input_upper=np.ones((n, nu)),
+        constraint_matrix=np.zeros((n, 0, nu)),
+        constraint_lower=np.zeros((n, 0)),
+        constraint_upper=np.zeros((n, 0)),
+        dt=dt,
+    )
+    blended = blend(problem, 0.0).state_reference
+    shift = blended - window
+    np.testing.assert_allclose(shift[0], blend.offsets, atol=1e-12)  # starts at the rider
+    after = dt * np.arange(n + 1) >= push
+    np.testing.assert_allclose(shift[after], 0.0, atol=1e-12)  # gone by the first push
+    vx = shift[:, names["vx"]]
+    assert np.all(vx <= 1e-12) and vx.min() < 0.0  # the body eased back as the offset fades
+    assert not blend.done(0.0) and blend.done(push)

@@ -117,6 +117,7 @@ from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
+from ridempc.mpc.switch_blend import SwitchBlend
 from ridempc.robots.delay_margin import tracking_damping
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -338,6 +339,7 @@ class MpcRider(Controller):
         self._steer_gain = deck.steer_gain if deck is not None else None
         # a yaw-rate command steered by the deck's roll, eq. (14) inverted
         self.roll_steering = RollSteering(gain=deck.steer_gain) if deck is not None else None
+        self._blend: SwitchBlend | None = None  # a re-push's reference blended in
         index, gain = self.layout.names, self.pair.roll_observer
         self.roll_observer = (
             RollObserver(index["board_roll"], index["board_roll_rate"], deck, gain)
@@ -490,6 +492,10 @@ class MpcRider(Controller):
             )
             self.manoeuvre = replace(wanted, start=start)
             self._anchor(estimate, now)
+            self._blend = None
+            switched = wanted.kind == REPUSH  # from wherever the coast left the rider
+        else:
+            switched = False
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
         mapped = self._mapped(estimate)
@@ -513,6 +519,11 @@ class MpcRider(Controller):
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
         problem = self.mpc.problem(t_ref, x0, drift)
+        if switched:
+            self._blend = SwitchBlend.at_switch(self.mpc.reference, self.layout, x0, t_ref)
+        if self._blend is not None:
+            problem = self._blend(problem, t_ref)
+            self._blend = None if self._blend.done(t_ref) else self._blend
         if coasting:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
