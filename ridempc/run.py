@@ -160,6 +160,8 @@ def check_request(request: RideRequest) -> CheckedRide:
             f"{platforms if platforms > 1 else 'none'})"
         )
     check_steering(scenario, board)
+    if scenario.push_off is not None and scenario.push_off.hold and controller is not None:
+        controller.hold_speed()
     if scenario.path is not None and controller is not None:  # the rider steers onto it
         controller = follow_path(controller, scenario.path, board)
     if request.duration is not None:

@@ -56,11 +56,12 @@ def test_a_repush_problem_starts_rolling_and_ends_at_its_target() -> None:
 
 def test_the_rider_pushes_again_once_the_board_has_slowed() -> None:
     selector = ManoeuvreSelector("cyberdog2", "skateboard")
-    assert REPUSH not in selector.targets  # the committed library pushes from rest only
     selector.targets = {**selector.targets, REPUSH: (0.5, 0.7, 1.0)}
     assert REPUSH_BAND == REPUSH_GAIN  # pushed when the board is at the entry's start
     coasting = Manoeuvre("accelerate", 0.7, 0.5)
     command = Command(velocity=0.7)
+    assert selector.repush(command, coasting, 9.0, 0.49) is coasting  # a push-off coasts on
+    selector.holds_speed = True  # the scenario holds its speed (push_off.hold)
     assert selector.repush(command, coasting, 9.0, 0.6) is coasting  # not slow enough yet
     pushed = selector.repush(command, coasting, 9.0, 0.49)
     assert (pushed.kind, pushed.target, pushed.start) == (REPUSH, 0.7, 9.0)
@@ -122,3 +123,17 @@ def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push
     vx = shift[:, names["vx"]]
     assert np.all(vx <= 1e-12) and vx.min() < 0.0  # the body eased back as the offset fades
     assert not blend.done(0.0) and blend.done(push)
+
+
+def test_the_committed_library_holds_the_repush_entries_its_pair_builds() -> None:
+    """``ridempc library build`` makes the re-pushes whose rolling start is no slower than
+    the least target, and the committed library holds them (the rider reads them)."""
+    from ridempc.trajopt.skate_pair import PAIR
+
+    names = [s.name for s in PAIR.entries(PAIR.default_targets)]
+    assert [n for n in names if n.startswith(REPUSH)] == [
+        "repush-0.50",
+        "repush-0.70",
+        "repush-1.00",
+    ]
+    assert ManoeuvreSelector("cyberdog2", "skateboard").targets[REPUSH] == (0.5, 0.7, 1.0)

@@ -144,6 +144,9 @@ class PathFollowing(Controller):
         self._diagnostics.update(cross_track=cross, path_yaw_rate=wanted)
         return wanted
 
+    def hold_speed(self) -> None:
+        self.inner.hold_speed()
+
     def reset(self, sensors: SensorPacket) -> None:
         self._index = None
         self._frame = None

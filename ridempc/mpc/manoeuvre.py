@@ -196,6 +196,9 @@ class ManoeuvreSelector:
         if "accelerate" not in self.targets:
             raise ConfigError(f"{folder / 'manifest.json'}: no 'accelerate' entries")
         self._last_wanted: float | None = None  # the commanded speed at the last call
+        # pushed again while rolling only where the ride asks to hold its speed: a push-off
+        # coasts after its push, as the paper's does (and as its measured figures were)
+        self.holds_speed = False
 
     def initial(self) -> Manoeuvre:
         return Manoeuvre(HOLD, self.targets["accelerate"][0])
@@ -235,7 +238,9 @@ class ManoeuvreSelector:
         rider drives only by pushing (no ``stop`` entries), once the board has slowed
         :data:`REPUSH_BAND` below a commanded speed that is not rest, the library's
         ``repush`` entry of that speed (clamped to its range), which starts from a board
-        rolling :data:`REPUSH_BAND` slower. The caller asks only while the rider coasts.
+        rolling :data:`REPUSH_BAND` slower. Only where the ride holds its speed
+        (:attr:`holds_speed`, a scenario's ``push_off.hold``); the caller asks only while the
+        rider coasts.
 
         Args:
             command: The command of the moment.
@@ -244,7 +249,9 @@ class ManoeuvreSelector:
             speed: The board's speed [m/s].
         """
         wanted = command.velocity
-        if REPUSH not in self.targets or wanted < MOVING or speed > wanted - REPUSH_BAND:
+        if not self.holds_speed or REPUSH not in self.targets:
+            return current
+        if wanted < MOVING or speed > wanted - REPUSH_BAND:
             return current
         return Manoeuvre(REPUSH, self._clamped(REPUSH, wanted), now)
 

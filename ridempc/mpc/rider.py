@@ -467,6 +467,9 @@ class MpcRider(Controller):
         self._tick += 1
         return out
 
+    def hold_speed(self) -> None:
+        self.selector.holds_speed = True  # the library's ``repush`` entries, where it has them
+
     def _mpc_tick(self, estimate: EstimatedState, command: Command, now: float) -> None:
         speed = self._speed(estimate)
         # The manoeuvre is chosen, and its phase matched, on the CoM's speed, which the

@@ -258,6 +258,9 @@ class PushOff(_Frozen):
 
     target: Annotated[Real, Field(gt=0.0, le=10.0)]  # [m/s], at most a command's speed
     judged_at: Time  # [s]
+    # push again while rolling, holding the commanded speed against rolling resistance (the
+    # library's ``repush`` entries); off, the board coasts after the push-off, as the paper's
+    hold: bool = False
 
 
 PUSH_OFF_WINDOW: float = 0.5  # [s]

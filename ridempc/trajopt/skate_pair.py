@@ -2,11 +2,11 @@
 
 Each target speed gives an entry ``accelerate-<v>``: from rest in the riding keyframe to
 the board at :math:`v` with all four feet back on the deck (:mod:`.skate_problem`). A
-``repush-<v>`` entry (:func:`repush_entry`, not in the committed library) starts instead
-from a board rolling at :math:`v -` :data:`REPUSH_GAIN` and pushes it back to :math:`v`:
-built and solved (IPOPT converges in 21-23 iterations), but the MPC rider fell on each of
-them in simulation (docs/tuning.md). Entries are warm-started from the nearest solved one
-of their kind by mapping its phases onto the new schedule.
+``repush-<v>`` entry (:func:`repush_entry`) starts instead from a board rolling at
+:math:`v -` :data:`REPUSH_GAIN` and pushes it back to :math:`v`; the MPC rider takes it
+only where a ride holds its speed (a scenario's ``push_off.hold``), blended in from her
+state at the switch (:mod:`ridempc.mpc.switch_blend`). Entries are warm-started from the
+nearest solved one of their kind by mapping its phases onto the new schedule.
 """
 
 from __future__ import annotations
@@ -72,7 +72,11 @@ def skate_options(overrides: dict[str, Any]) -> SkateOptions:
 
 
 def _entries(targets: Sequence[float]) -> list[EntrySpec]:
-    return [EntrySpec("accelerate", float(t)) for t in targets]
+    """Per target an ``accelerate`` from rest and, where its rolling start is no slower
+    than the least target (0.3 m/s in the committed library), a ``repush``."""
+    least = min(targets, default=0.0)
+    repush = [repush_entry(t) for t in targets if t - REPUSH_GAIN >= least - 1e-9]
+    return [EntrySpec("accelerate", float(t)) for t in targets] + repush
 
 
 def repush_entry(target: float) -> EntrySpec:
