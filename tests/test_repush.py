@@ -92,11 +92,6 @@ def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push
     x0[names["com_x"]] += 0.05  # 3 cm ahead of the knot on a deck 2 cm further on
     x0[names["board_x"]] += 0.02
     x0[names["q_FL_knee"]] += 0.1
-    blend = SwitchBlend.at_switch(reference, layout, x0, 0.0)
-    assert blend.offsets[names["com_x"]] == pytest.approx(0.03)
-    assert blend.offsets[names["board_x"]] == 0.0
-    assert blend.offsets[names["q_FL_knee"]] == pytest.approx(0.1)
-    assert blend.duration == pytest.approx(push)
     n, nx, nu, dt = 40, len(x0), 2, 0.05
     window = reference.states_at(dt * np.arange(n + 1))
     problem = MpcProblem(
@@ -115,6 +110,11 @@ def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push
         constraint_upper=np.zeros((n, 0)),
         dt=dt,
     )
+    blend = SwitchBlend.at_switch(problem, reference, layout, 0.0)
+    assert blend.offsets[names["com_x"]] == pytest.approx(0.03)
+    assert blend.offsets[names["board_x"]] == 0.0
+    assert blend.offsets[names["q_FL_knee"]] == pytest.approx(0.1)
+    assert blend.duration == pytest.approx(push)
     blended = blend(problem, 0.0).state_reference
     shift = blended - window
     np.testing.assert_allclose(shift[0], blend.offsets, atol=1e-12)  # starts at the rider

@@ -418,11 +418,14 @@ class MpcRider(Controller):
         if estimate is not None:
             self._anchor(estimate, sensors.time)
 
-    def _anchor(self, estimate: EstimatedState, now: float) -> None:
+    def _anchor(self, estimate: EstimatedState, now: float, turned: float = 0.0) -> None:
+        """Lay the library frame so that the board's estimate lands on the reference's
+        board at ``now``, its heading turned by ``turned`` [rad] (the turn the reference is
+        given, :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.with_turn`)."""
         self.manoeuvre = self.manoeuvre.started(now)
         state = self.mpc.reference.states_at(np.array([self.manoeuvre.reference_time(now)]))[0]
-        pose = self.layout.board_pose(state)
-        self.map.anchor(self._mapped(estimate), pose)
+        x, y, heading = self.layout.board_pose(state)
+        self.map.anchor(self._mapped(estimate), (x, y, heading + turned))
 
     def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
         if self._hold is None:
@@ -494,9 +497,12 @@ class MpcRider(Controller):
                 self.pair.start_speed,
             )
             self.manoeuvre = replace(wanted, start=start)
-            self._anchor(estimate, now)
-            self._blend = None
             switched = wanted.kind == REPUSH  # from wherever the coast left the rider
+            # a re-push starts mid-turn: the reference's heading already carries the turn
+            # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
+            # turn back at once and fell in the push)
+            self._anchor(estimate, now, self._turned if switched else 0.0)
+            self._blend = None
         else:
             switched = False
         t_ref = self.manoeuvre.reference_time(now)
@@ -522,17 +528,17 @@ class MpcRider(Controller):
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
         problem = self.mpc.problem(t_ref, x0, drift)
-        if switched:
-            self._blend = SwitchBlend.at_switch(self.mpc.reference, self.layout, x0, t_ref)
-        if self._blend is not None:
-            problem = self._blend(problem, t_ref)
-            self._blend = None if self._blend.done(t_ref) else self._blend
         if coasting:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
+        if switched:
+            self._blend = SwitchBlend.at_switch(problem, self.mpc.reference, self.layout, t_ref)
+        if self._blend is not None:
+            problem = self._blend(problem, t_ref)
+            self._blend = None if self._blend.done(t_ref) else self._blend
         problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
         if self.crouch is not None:
             problem = self.crouch.lower(problem, names["com_z"], now)

@@ -75,11 +75,17 @@ class SwitchBlend:
 
     @classmethod
     def at_switch(
-        cls, reference: MotionReference, layout: StateLayout, x0: Array, t_ref: float
+        cls,
+        problem: MpcProblem,
+        reference: MotionReference,
+        layout: StateLayout,
+        t_ref: float,
     ) -> SwitchBlend:
-        """The blend from the rider's state ``x0`` (nx) at reference time ``t_ref`` [s]."""
+        """The blend from the rider's state (``problem``'s initial state, nx) to its state
+        reference (as shaped by the commands: a commanded deck roll replaces the entry's)
+        at reference time ``t_ref`` [s] of ``reference``."""
         names = layout.names
-        here = reference.states_at(np.array([t_ref]))[0]
+        x0, here = problem.initial_state, problem.state_reference[0]
         platform = layout.prefixes[0]
         offsets = np.zeros(len(x0))
         rates = []
@@ -92,8 +98,9 @@ class SwitchBlend:
                 offsets[i] -= x0[j] - here[j]
             rates.append((i, names.get(rate, -1)))
         base = layout.base_prefix
+        angles = (f"{base}roll", f"{base}pitch", f"{platform}roll", f"{platform}roll_rate")
         for name, i in names.items():
-            if name.startswith("q_") or name in (f"{base}roll", f"{base}pitch"):
+            if name.startswith("q_") or name in angles:
                 offsets[i] = x0[i] - here[i]
         duration = max(first_push_time(reference) - t_ref, MIN_BLEND)
         return cls(t_ref, duration, offsets, tuple(rates))
