@@ -102,9 +102,12 @@ def test_path_metrics_from_a_log() -> None:
 
 
 def test_the_steering_scenarios_load() -> None:
-    for name in ("yaw-steps", "circle", "slalom"):
+    for name in ("yaw-steps", "yaw-steps-hold", "circle", "slalom"):
         scenario = resolve_scenario(name, "skateboard")
         assert scenario.boards == ("skateboard",)
+    held = resolve_scenario("yaw-steps-hold", "skateboard").push_off
+    assert held is not None and held.hold  # pushed again while rolling
+    assert not resolve_scenario("push-off-0.5", "skateboard").push_off.hold  # type: ignore[union-attr]
     assert resolve_scenario("circle", "skateboard").path.radius == 3.0  # type: ignore[union-attr]
 
 

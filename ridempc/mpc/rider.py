@@ -510,7 +510,8 @@ class MpcRider(Controller):
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
-        if balancing:  # steered on four legs; a push goes straight on its three
+        pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
+        if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
             roll = roll + self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
