@@ -28,6 +28,7 @@ from ridempc.io import atomic_write_json, atomic_write_npz
 from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, load_scenario_file, resolve_scenario
+from ridempc.scenarios.hold import check_hold
 from ridempc.scenarios.path_metrics import path_metrics
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
@@ -160,6 +161,7 @@ def check_request(request: RideRequest) -> CheckedRide:
             f"{platforms if platforms > 1 else 'none'})"
         )
     check_steering(scenario, board)
+    check_hold(scenario, robot.name if robot is not None else None, board_name)
     if scenario.push_off is not None and scenario.push_off.hold and controller is not None:
         controller.hold_speed()
     if scenario.path is not None and controller is not None:  # the rider steers onto it

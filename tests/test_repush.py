@@ -137,3 +137,22 @@ def test_the_committed_library_holds_the_repush_entries_its_pair_builds() -> Non
         "repush-1.00",
     ]
     assert ManoeuvreSelector("cyberdog2", "skateboard").targets[REPUSH] == (0.5, 0.7, 1.0)
+
+
+def test_holding_the_speed_is_refused_where_the_library_cannot_push_again() -> None:
+    """``push_off.hold`` needs ``repush`` entries: the skateboard's library has them, the
+    hovershoes' has none (exit 2 from the CLI, naming the field)."""
+    from ridempc.scenarios.hold import check_hold
+    from ridempc.scenarios.scenario import Scenario
+
+    held = Scenario.model_validate(
+        {
+            "name": "held",
+            "duration": 5.0,
+            "push_off": {"target": 0.7, "judged_at": 5.0, "hold": True},
+        }
+    )
+    check_hold(held, "cyberdog2", "skateboard")
+    check_hold(held, None, "skateboard")  # a dead weight holds nothing
+    with pytest.raises(ConfigError, match=r"field 'push_off.hold' is true; allowed: .*repush"):
+        check_hold(held, "cassie", "hovershoes")
