@@ -529,7 +529,10 @@ class MpcRider(Controller):
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
         problem = self.mpc.problem(t_ref, x0, drift)
-        if coasting:
+        # A re-push before its first push (while its blend runs) coasts too, its speeds
+        # scaled to the board's: the entry's planned body speed, faster than a deck that
+        # slows more than its model, had the MPC push the body forward and brake the deck.
+        if coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, roll):
