@@ -18,14 +18,18 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ridempc.boards import NO_BOARD, load_board
+from ridempc.boards.steering import check_steering
 from ridempc.checks import writable_dir
 from ridempc.controllers import NO_ROBOT, make_controller
 from ridempc.controllers.base import Controller
+from ridempc.controllers.path_following import follow_path
 from ridempc.errors import ConfigError, WriteFailed
 from ridempc.io import atomic_write_json, atomic_write_npz
 from ridempc.results import check_clearable, clear_results
 from ridempc.robots import load_robot
 from ridempc.scenarios import Scenario, load_scenario_file, resolve_scenario
+from ridempc.scenarios.hold import check_hold
+from ridempc.scenarios.path_metrics import path_metrics
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.levelling import step_levelling
 from ridempc.sim.metrics import run_metrics
@@ -161,6 +165,12 @@ def check_request(request: RideRequest) -> CheckedRide:
             f"allowed: none, or one per independent platform (board '{board_name}' has "
             f"{platforms if platforms > 1 else 'none'})"
         )
+    check_steering(scenario, board)
+    check_hold(scenario, robot.name if robot is not None else None, board_name)
+    if scenario.push_off is not None and scenario.push_off.hold and controller is not None:
+        controller.hold_speed()
+    if scenario.path is not None and controller is not None:  # the rider steers onto it
+        controller = follow_path(controller, scenario.path, board)
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
 
@@ -369,6 +379,7 @@ def _summary(
         "rider_mass_kg": round(scene.rider_mass, 4),
         **run_metrics(result, scenario, robot),
         **step_levelling(result.log, scenario),
+        **path_metrics(result.log, scenario),
         **(controller.summary() if controller is not None else {}),
         "files": files,
     }

@@ -10,14 +10,13 @@ import pinocchio as pin
 import pytest
 
 from ridempc.baselines.quadruped_legs import QuadrupedLegs
-from ridempc.baselines.quadruped_skateboard import QuadrupedSkateboardPD, steering_roll
+from ridempc.baselines.quadruped_skateboard import QuadrupedSkateboardPD
 from ridempc.baselines.quadruped_skateboard_gains import (
     DEFAULT_GAINS_FILE,
     load_quadruped_skateboard_gains,
 )
 from ridempc.baselines.quadruped_support import fit_support_plane, vertical_loads
 from ridempc.boards import load_board
-from ridempc.boards.skateboard.reduced import yaw_rate
 from ridempc.errors import ConfigError
 from ridempc.robots import load_robot
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
@@ -117,15 +116,6 @@ def test_vertical_loads_put_the_centre_of_pressure_under_the_com() -> None:
     assert loads.sum() == pytest.approx(87.3)
     np.testing.assert_allclose(loads @ feet / loads.sum(), com, atol=1e-12)
     assert vertical_loads(feet, np.array([0.0, -0.2]), 87.3, 2.0).min() == 2.0
-
-
-def test_steering_roll_inverts_eq_14() -> None:
-    params = load_board("skateboard").params
-    gain = params.reduced.steer_gain
-    roll = steering_roll(0.4, 1.5, gain, 0.3)
-    assert roll < 0.0  # a left turn leans left (negative roll raises the right edge)
-    assert yaw_rate(1.5, roll, gain) == pytest.approx(0.4)
-    assert steering_roll(0.4, 0.1, gain, 0.3) == 0.0  # too slow to steer
 
 
 # ---------------------------------------------------------------- gains and boards

@@ -17,7 +17,9 @@ torques, and the VIO's forward speed for steering. Per tick (500 Hz):
 2. **Roll reference.** :math:`\\varphi^* = \\mathrm{clip}(\\varphi_{cmd} + \\varphi_{steer})`,
    where a yaw-rate command becomes a roll by eq. (14),
    :math:`\\sin\\varphi_{steer} = -\\dot\\psi^* K_{board} / v`, once the board rolls at
-   :math:`v \\ge v_{min}` (VIO speed); :math:`\\dot\\varphi^*, \\ddot\\varphi^*` by differences.
+   :math:`v \\ge v_{min}` (VIO speed), within the stance's roll
+   (:class:`~ridempc.boards.skateboard.steering.RollSteering`); :math:`\\dot\\varphi^*,
+   \\ddot\\varphi^*` by differences.
 3. **Lateral shift of the centre of mass** to the right (-y), :math:`u`, that rolls the deck.
    The reduced roll model, eqs. (6)-(7), :math:`I_{Bx}\\ddot\\varphi = \\tau - K_B\\varphi -
    B_B\\dot\\varphi`, takes the rider's roll torque about the deck's top centre, and a rider
@@ -103,6 +105,7 @@ from ridempc.boards.skateboard.parameters import (
     SkateboardParameters,
     SkateboardReducedParameters,
 )
+from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -113,25 +116,12 @@ from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 
-__all__ = ["QuadrupedSkateboardPD", "StanceState", "steering_roll"]
+__all__ = ["QuadrupedSkateboardPD", "StanceState"]
 
 Array = NDArray[np.float64]
 GRAVITY: float = 9.81  # [m] / [s]^2
 
 
-def steering_roll(yaw_rate: float, speed: float, steer_gain: float, min_speed: float) -> float:
-    """Deck roll that turns the board at ``yaw_rate`` [rad/s] at ``speed`` [m/s], eq. (14):
-    :math:`\\sin\\varphi = -\\dot\\psi / (v / K_{board})` [rad]; zero below ``min_speed``.
-
-    Args:
-        yaw_rate: Wanted yaw rate, positive to the left [rad/s].
-        speed: The board's forward speed [m/s].
-        steer_gain: :math:`1 / K_{board}` [1/m].
-        min_speed: Below this speed the board does not steer [m/s].
-    """
-    if abs(speed) < min_speed:
-        return 0.0
-    return -math.asin(max(-1.0, min(1.0, yaw_rate / (steer_gain * speed))))
 
 
 def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:
@@ -236,6 +226,11 @@ class QuadrupedSkateboardPD(Controller):
         )
         self.rate_hz = self.gains.rate_hz
         self.roll_model = _roll_model(board)
+        self.steering = (  # a yaw rate to a deck roll, eq. (14)
+            RollSteering(gain=self.roll_model.steer_gain, min_speed=self.gains.steering.min_speed)
+            if self.roll_model is not None
+            else None
+        )
         motor_joints = tuple(m.joint for m in robot.motors)
         self.legs = QuadrupedLegs(
             build_pinocchio_robot(robot), robot.params.contact_sites, motor_joints
@@ -340,15 +335,13 @@ class QuadrupedSkateboardPD(Controller):
 
     def roll_reference(self, sensors: SensorPacket, command: Command) -> tuple[float, float, float]:
         """:math:`(\\varphi^*, \\dot\\varphi^*, \\ddot\\varphi^*)` [rad, rad/s, rad/s^2]."""
-        assert self.roll_model is not None
+        assert self.steering is not None
         steering = self.gains.steering
         speed = 0.0
         if sensors.vio is not None:
             vio = sensors.vio
             speed = math.cos(vio.yaw) * vio.velocity[0] + math.sin(vio.yaw) * vio.velocity[1]
-        roll = command.roll + steering_roll(
-            command.yaw_rate, speed, self.roll_model.steer_gain, steering.min_speed
-        )
+        roll = command.roll + self.steering.roll(command.yaw_rate, speed)
         roll = _clip(roll, steering.max_roll)
         rate = acceleration = 0.0
         if self._previous is not None:

@@ -43,6 +43,10 @@ class Controller(ABC):
         self.board = board  # the board's name ("none" on flat ground)
         self.command_preview: Callable[[float], Command] | None = None
 
+    def hold_speed(self) -> None:  # noqa: B027 - optional hook
+        """Push again while rolling to hold the commanded speed (a scenario's
+        ``push_off.hold``); a controller that cannot push ignores it."""
+
     def reset(self, sensors: SensorPacket) -> None:  # noqa: B027 - optional hook
         """Called once with the first sensor packet, before the first :meth:`update`."""
 

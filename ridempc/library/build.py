@@ -186,7 +186,7 @@ def build_library(
         raise ConfigError(f"--jobs must be at least 1, got {jobs}")
     folder = out or library_folder(robot, board)
     specs = pair.entries(pair.default_targets if targets is None else targets)
-    specs = [dataclasses.replace(s, options=dict(options or {})) for s in specs]
+    specs = [dataclasses.replace(s, options={**s.options, **(options or {})}) for s in specs]
     for spec in specs:
         pair.check(spec)
     specs.sort(key=lambda s: (s.kind, s.target))

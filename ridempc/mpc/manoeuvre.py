@@ -18,6 +18,10 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   ``RETARGET_BAND`` of its target (a ramp retargets in a few steps, not at every tick), and
   it moves to the exact command once the command settles; a lower speed that is not rest
   starts at the entry's end, riding steadily at it;
+- **repush** where the library has ``repush`` entries (the skateboard's): a coasting rider
+  whose board has slowed :data:`REPUSH_BAND` below the commanded speed pushes one more
+  stride from the rolling board back up to it (:meth:`ManoeuvreSelector.repush`), and
+  coasts again at its end;
 - **stop** when the command returns to zero, where the library has ``stop`` entries (the
   skateboard has none: it coasts on, four-leg balancing); also to **slow down** while the
   rider is more than ``RETARGET_BAND`` faster than a commanded speed that is not rest: the
@@ -52,6 +56,8 @@ from ridempc.scenarios.scenario import Command
 __all__ = [
     "HOLD",
     "MOVING",
+    "REPUSH",
+    "REPUSH_BAND",
     "RETARGET_BAND",
     "HEADING_SUFFIXES",
     "YAW_RATE_SUFFIXES",
@@ -64,6 +70,10 @@ __all__ = [
 Array = NDArray[np.float64]
 MOVING: float = 0.05  # [m/s] a commanded speed below this is rest
 HOLD: str = "hold"
+REPUSH: str = "repush"  # a stride pushed again from a rolling board (the skateboard's)
+# [m/s] how far below the commanded speed a coasting board is pushed again: the speed a
+# ``repush`` entry regains (ridempc.trajopt.skate_pair.REPUSH_GAIN)
+REPUSH_BAND: float = 0.2
 # [m/s] a running ``accelerate`` is kept while the command stays this close to its target: a
 # ramped command would otherwise restart the trajectory at every MPC tick (the Segway's
 # 0 -> 1 m/s ramp over 1 s retargeted 30 times, its reference time jumping between 0 and
@@ -91,7 +101,7 @@ class Manoeuvre:
     """A library trajectory and when it started.
 
     Attributes:
-        kind: ``hold``, ``accelerate`` or ``stop``.
+        kind: ``hold``, ``accelerate``, ``repush`` or ``stop``.
         target: The entry's target speed [m/s].
         start: Simulation time at which the reference's time is zero [s].
     """
@@ -186,6 +196,9 @@ class ManoeuvreSelector:
         if "accelerate" not in self.targets:
             raise ConfigError(f"{folder / 'manifest.json'}: no 'accelerate' entries")
         self._last_wanted: float | None = None  # the commanded speed at the last call
+        # pushed again while rolling only where the ride asks to hold its speed: a push-off
+        # coasts after its push, as the paper's does (and as its measured figures were)
+        self.holds_speed = False
 
     def initial(self) -> Manoeuvre:
         return Manoeuvre(HOLD, self.targets["accelerate"][0])
@@ -211,12 +224,36 @@ class ManoeuvreSelector:
                 return current
             return Manoeuvre("stop", self._clamped("stop", speed), now)
         goal = Manoeuvre("accelerate", self._clamped("accelerate", wanted), now)
+        if current.kind == REPUSH and abs(current.target - self._clamped(REPUSH, wanted)) < 1e-6:
+            return current
         if current.kind == "accelerate":
             gap = abs(goal.target - current.target)
             ramping = previous is not None and not math.isclose(previous, wanted, abs_tol=1e-9)
             if gap < 1e-6 or (ramping and gap < RETARGET_BAND):
                 return current
         return goal
+
+    def repush(self, command: Command, current: Manoeuvre, now: float, speed: float) -> Manoeuvre:
+        """A stride pushed again from the rolling board, or ``current``: on a board the
+        rider drives only by pushing (no ``stop`` entries), once the board has slowed
+        :data:`REPUSH_BAND` below a commanded speed that is not rest, the library's
+        ``repush`` entry of that speed (clamped to its range), which starts from a board
+        rolling :data:`REPUSH_BAND` slower. Only where the ride holds its speed
+        (:attr:`holds_speed`, a scenario's ``push_off.hold``); the caller asks only while the
+        rider coasts.
+
+        Args:
+            command: The command of the moment.
+            current: The manoeuvre under way (coasting at its end).
+            now: Time [s].
+            speed: The board's speed [m/s].
+        """
+        wanted = command.velocity
+        if not self.holds_speed or REPUSH not in self.targets:
+            return current
+        if wanted < MOVING or speed > wanted - REPUSH_BAND:
+            return current
+        return Manoeuvre(REPUSH, self._clamped(REPUSH, wanted), now)
 
     @staticmethod
     def phase_start(
@@ -229,11 +266,16 @@ class ManoeuvreSelector:
         reference's steady start and whatever of the lean-in is slower than that
         (:attr:`~ridempc.mpc.pairs.MpcPair.start_speed`).
 
+        A ``repush`` starts at its start: the rider pushes again when the board has slowed
+        to the entry's rolling start.
+
         A rider already faster than the whole ``accelerate`` reference (a slow-down to a
         lower speed that is not rest) starts at the reference's end, riding steadily at
         its target: the MPC brakes to it. Started from rest instead, the reference asked a
         rider at 4 m/s for 0 m/s at once (the Segway's stop from 4 m/s fell in 0.3 s).
         """
+        if kind == REPUSH:  # from its rolling start, the speed the board was pushed at:
+            return now  # matched later, the rider at 0.52 m/s joined a 0.5 one mid-push
         if kind == "accelerate":
             speed = max(speed, least)
             reached = np.nonzero(speeds >= speed)[0]

@@ -17,9 +17,12 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
-   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`); a commanded deck roll
+   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`, and once it has slowed below
+   the command it pushes again from the rolling board, the library's ``repush``,
+   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.repush`); a commanded deck roll
    replaces the reference's roll, and on the skateboard turns the reference's heading at
-   the rate the roll steers (eq. 14); on the Segway, whose knee bar the plan cannot push,
+   the rate the roll steers (eq. 14), a commanded yaw rate adding the roll that steers it
+   (:mod:`ridempc.boards.skateboard.steering`); on the Segway, whose knee bar the plan cannot push,
    the rider crouches into the robot's riding keyframe and leans into the bar: a yaw-rate
    loop moves the reference's centre of mass sideways, and riding, the reference's
    headings and the heading the frame follows turn at the commanded rate and the frame's
@@ -83,6 +86,7 @@ from ridempc.boards.board import Board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.skateboard.parameters import SkateboardParameters
 from ridempc.boards.skateboard.reduced import yaw_rate
+from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -94,6 +98,7 @@ from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
     HOLD,
+    REPUSH,
     YAW_RATE_SUFFIXES,
     Manoeuvre,
     ManoeuvreSelector,
@@ -112,6 +117,7 @@ from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
+from ridempc.mpc.switch_blend import SwitchBlend
 from ridempc.robots.delay_margin import tracking_damping
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -340,6 +346,9 @@ class MpcRider(Controller):
             else None
         )
         self._steer_gain = deck.steer_gain if deck is not None else None
+        # a yaw-rate command steered by the deck's roll, eq. (14) inverted
+        self.roll_steering = RollSteering(gain=deck.steer_gain) if deck is not None else None
+        self._blend: SwitchBlend | None = None  # a re-push's reference blended in
         index, gain = self.layout.names, self.pair.roll_observer
         self.roll_observer = (
             RollObserver(index["board_roll"], index["board_roll_rate"], deck, gain)
@@ -418,11 +427,14 @@ class MpcRider(Controller):
         if estimate is not None:
             self._anchor(estimate, sensors.time)
 
-    def _anchor(self, estimate: EstimatedState, now: float) -> None:
+    def _anchor(self, estimate: EstimatedState, now: float, turned: float = 0.0) -> None:
+        """Lay the library frame so that the board's estimate lands on the reference's
+        board at ``now``, its heading turned by ``turned`` [rad] (the turn the reference is
+        given, :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.with_turn`)."""
         self.manoeuvre = self.manoeuvre.started(now)
         state = self.mpc.reference.states_at(np.array([self.manoeuvre.reference_time(now)]))[0]
-        pose = self.layout.board_pose(state)
-        self.map.anchor(self._mapped(estimate), pose)
+        x, y, heading = self.layout.board_pose(state)
+        self.map.anchor(self._mapped(estimate), (x, y, heading + turned))
 
     def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
         if self._hold is None:
@@ -467,6 +479,9 @@ class MpcRider(Controller):
         self._tick += 1
         return out
 
+    def hold_speed(self) -> None:
+        self.selector.holds_speed = True  # the library's ``repush`` entries, where it has them
+
     def _mpc_tick(self, estimate: EstimatedState, command: Command, now: float) -> None:
         speed = self._speed(estimate)
         # The manoeuvre is chosen, and its phase matched, on the CoM's speed, which the
@@ -477,6 +492,8 @@ class MpcRider(Controller):
         wanted = self.selector.select(
             self._speed_command(command, now), self.manoeuvre, now, rider_speed
         )
+        if wanted is self.manoeuvre and self._coasting(self.manoeuvre.reference_time(now)):
+            wanted = self.selector.repush(command, wanted, now, speed)  # slowed: push again
         if wanted is not self.manoeuvre:
             self.mpc.retarget(wanted.library_kind, wanted.target)
             reference = self.mpc.reference
@@ -489,12 +506,22 @@ class MpcRider(Controller):
                 self.pair.start_speed,
             )
             self.manoeuvre = replace(wanted, start=start)
-            self._anchor(estimate, now)
+            switched = wanted.kind == REPUSH  # from wherever the coast left the rider
+            # a re-push starts mid-turn: the reference's heading already carries the turn
+            # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
+            # turn back at once and fell in the push)
+            self._anchor(estimate, now, self._turned if switched else 0.0)
+            self._blend = None
+        else:
+            switched = False
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
+        pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
+        if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
+            roll = roll + self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
@@ -511,12 +538,20 @@ class MpcRider(Controller):
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
         problem = self.mpc.problem(t_ref, x0, drift)
-        if coasting:
+        # A re-push before its first push (while its blend runs) coasts too, its speeds
+        # scaled to the board's: the entry's planned body speed, faster than a deck that
+        # slows more than its model, had the MPC push the body forward and brake the deck.
+        if coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
         problem = self.selector.with_command(problem, names, roll, balance)
+        if switched:
+            self._blend = SwitchBlend.at_switch(problem, self.mpc.reference, self.layout, t_ref)
+        if self._blend is not None:
+            problem = self._blend(problem, t_ref)
+            self._blend = None if self._blend.done(t_ref) else self._blend
         problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
         if self.crouch is not None:
             problem = self.crouch.lower(problem, names["com_z"], now)
@@ -692,7 +727,7 @@ class MpcRider(Controller):
         an ``accelerate`` on a board it drives only by pushing off."""
         return (
             self.selector.coasts
-            and self.manoeuvre.kind == "accelerate"
+            and self.manoeuvre.kind in ("accelerate", REPUSH)
             and t_ref >= float(self.mpc.reference.times[-1])
         )
 
@@ -759,6 +794,20 @@ class MpcRider(Controller):
         if previous is not None and now > previous[0]:
             rate = (command.roll - previous[1]) / (now - previous[0])
         return np.asarray(command.roll + rate * (times - now), dtype=float)
+
+    def _steering_roll(self, command: Command, now: float, speed: float) -> Array:
+        """The deck roll that steers the commanded yaw rate at the horizon's nodes [rad]
+        (:class:`~ridempc.boards.skateboard.steering.RollSteering`, at the board's speed
+        :math:`v` [m/s]), each read the pair's ``roll_lead`` ahead as the commanded roll
+        is; zero on a board that does not steer by its roll."""
+        settings = self.mpc.settings
+        if self.roll_steering is None:
+            return np.zeros(settings.horizon + 1)
+        times = now + self.pair.roll_lead + settings.dt * np.arange(settings.horizon + 1)
+        rates = self._planned("yaw_rate", times)
+        if rates is None:
+            rates = np.full(len(times), float(command.yaw_rate))
+        return np.array([self.roll_steering.roll(float(w), speed) for w in rates])
 
     def _roll_turn(self, roll: Array, speed: float) -> Array:
         """The turn a commanded deck roll steers, over the horizon's steps [rad/s]: on the

@@ -18,6 +18,12 @@ non-physical values are refused with the field named). Example::
     force = [60.0, 0.0, 0.0]   # world frame [N]
     duration = 0.2             # [s]
 
+    [path]                     # a path to follow, see ridempc.scenarios.path
+    kind = "circle"            # or "slalom"
+    start = 6.5                # [s] laid from the rider's pose then
+    entry = 1.0                # [m] ahead of her
+    radius = 3.0               # [m], positive turning left
+
     [noise]                    # sensor noise overrides, see SensorNoise
     vio_latency = 0.05
 
@@ -62,6 +68,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from ridempc.scenarios.path import PathCommand
 from ridempc.scenarios.terrain import TerrainItem, check_terrain
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
 from ridempc.sim.sensors import SensorNoise
@@ -255,6 +262,9 @@ class PushOff(_Frozen):
 
     target: Annotated[Real, Field(gt=0.0, le=10.0)]  # [m/s], at most a command's speed
     judged_at: Time  # [s]
+    # push again while rolling, holding the commanded speed against rolling resistance (the
+    # library's ``repush`` entries); off, the board coasts after the push-off, as the paper's
+    hold: bool = False
 
 
 PUSH_OFF_WINDOW: float = 0.5  # [s]
@@ -278,6 +288,7 @@ class Scenario(_Frozen):
     noise: SensorNoise = SensorNoise()
     push_off: PushOff | None = None
     terrain: tuple[TerrainItem, ...] = ()  # [[terrain]]: see ridempc.scenarios.terrain
+    path: PathCommand | None = None  # a path to follow (ridempc.scenarios.path)
 
     @model_validator(mode="after")
     def _terrain_fits(self) -> Scenario:
@@ -304,6 +315,8 @@ class Scenario(_Frozen):
         times += [(f"changes.{i}.t", c.t) for i, c in enumerate(self.changes)]
         if self.push_off is not None:
             times.append(("push_off.judged_at", self.push_off.judged_at))
+        if self.path is not None:
+            times.append(("path.start", self.path.start))
         for where, t in times:
             if t > self.duration or (where == "metrics_start" and t >= self.duration):
                 raise ValueError(

@@ -142,6 +142,7 @@ def push_schedule(
     speed_per_stride: float = 0.3,
     min_push: float = 0.2,
     max_push: float = 0.5,
+    start_speed: float = 0.0,
 ) -> ContactSchedule:
     """The acceleration schedule of the skateboard paper for one target speed.
 
@@ -165,8 +166,12 @@ def push_schedule(
         speed_per_stride: Speed gained per push, which sets the number of strides [m/s].
         min_push: Shortest push [s].
         max_push: Longest push [s].
+        start_speed: Board speed at the start [m/s]: a rolling board pushed again needs
+            the strides of the speed it gains, and one more for what the wheels' rolling
+            resistance takes while it pushes (0.16 m/s^2 over a stride's 2.3 s: more than
+            one push adds).
     """
-    strides = strides_for(target, speed_per_stride)
+    strides = strides_for(target - start_speed, speed_per_stride) + (start_speed > 0.0)
 
     def snap(t: float) -> float:
         return round(t / dt) * dt
@@ -176,7 +181,7 @@ def push_schedule(
 
     phases = [Phase("four-leg", snap(settle), contacts(Contact.BOARD))]
     for s in range(strides):
-        expected = target * (s + 0.5) / strides
+        expected = start_speed + (target - start_speed) * (s + 0.5) / strides
         push = snap(min(max_push, max(min_push, sweep / max(expected, 1e-6))))
         start, mode = (Contact.BOARD, "three-leg") if s == 0 else (Contact.GROUND, "recover")
         phases.append(

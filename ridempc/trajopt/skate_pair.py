@@ -1,8 +1,12 @@
 """CyberDog2 on the skateboard: acceleration trajectories to target speeds (skateboard paper).
 
-Each target speed gives one entry, ``accelerate-<v>``: from rest in the riding keyframe to
-the board at :math:`v` with all four feet back on the deck (:mod:`.skate_problem`). Entries
-are warm-started from the nearest solved one by mapping its phases onto the new schedule.
+Each target speed gives an entry ``accelerate-<v>``: from rest in the riding keyframe to
+the board at :math:`v` with all four feet back on the deck (:mod:`.skate_problem`). A
+``repush-<v>`` entry (:func:`repush_entry`) starts instead from a board rolling at
+:math:`v -` :data:`REPUSH_GAIN` and pushes it back to :math:`v`; the MPC rider takes it
+only where a ride holds its speed (a scenario's ``push_off.hold``), blended in from her
+state at the switch (:mod:`ridempc.mpc.switch_blend`). Entries are warm-started from the
+nearest solved one of their kind by mapping its phases onto the new schedule.
 """
 
 from __future__ import annotations
@@ -31,10 +35,13 @@ from ridempc.trajopt.skate_problem import (
 )
 from ridempc.trajopt.skateboard import BOARD_STATE, SkateboardModel, skateboard_model
 
-__all__ = ["PAIR", "skate_models", "skate_options"]
+__all__ = ["PAIR", "REPUSH_GAIN", "repush_entry", "skate_models", "skate_options"]
 
 Array = NDArray[np.float64]
 ROBOT, BOARD = "cyberdog2", "skateboard"
+# [m/s] the speed a re-push regains: what the board loses coasting for 1.25 s (0.16 m/s^2 of
+# rolling resistance), within one stride's 0.3 m/s (speed_per_stride)
+REPUSH_GAIN: float = 0.2
 
 
 @lru_cache(maxsize=1)
@@ -65,12 +72,24 @@ def skate_options(overrides: dict[str, Any]) -> SkateOptions:
 
 
 def _entries(targets: Sequence[float]) -> list[EntrySpec]:
-    return [EntrySpec("accelerate", float(t)) for t in targets]
+    """Per target an ``accelerate`` from rest and, where its rolling start is no slower
+    than the least target (0.3 m/s in the committed library), a ``repush``."""
+    least = min(targets, default=0.0)
+    repush = [repush_entry(t) for t in targets if t - REPUSH_GAIN >= least - 1e-9]
+    return [EntrySpec("accelerate", float(t)) for t in targets] + repush
+
+
+def repush_entry(target: float) -> EntrySpec:
+    """The ``repush`` entry to ``target`` [m/s], from a board rolling :data:`REPUSH_GAIN`
+    slower (build it with :func:`ridempc.library.build.solve_entry`)."""
+    return EntrySpec("repush", float(target), {"start_speed": round(target - REPUSH_GAIN, 6)})
 
 
 def _check(spec: EntrySpec) -> None:
-    if spec.kind != "accelerate":
-        raise ConfigError(f"{ROBOT}-{BOARD} has no '{spec.kind}' trajectories (valid: accelerate)")
+    if spec.kind not in ("accelerate", "repush"):
+        raise ConfigError(
+            f"{ROBOT}-{BOARD} has no '{spec.kind}' trajectories (valid: accelerate, repush)"
+        )
     options = skate_options(spec.options)
     bound = _speed_bound(options)
     if not 0.0 < spec.target <= bound:
@@ -79,6 +98,11 @@ def _check(spec: EntrySpec) -> None:
             f"can help beyond {bound:.1f} m/s (the pushing foot, still on the ground for at "
             f"least {options.min_push:g} s, would have to sweep farther or faster than its "
             "leg allows); targets must be in (0, that]"
+        )
+    if (spec.kind == "repush") != (options.start_speed > 0.0) or options.start_speed >= spec.target:
+        raise ConfigError(
+            f"{spec.name}: start_speed {options.start_speed:g} m/s; allowed: 0 for "
+            "accelerate, between 0 and the target for repush"
         )
 
 
@@ -136,7 +160,9 @@ def _warm(problem: TrajectoryProblem, neighbour: Neighbour) -> Guess:
     states[:, nr : nr + 2] = board_xy
     states[:, 0:2] = board_xy + relative
     low = problem.lbw[: problem.nx] * problem.state_scale
-    states[0] = low  # node 0 is fixed by its bounds: the keyframe at rest
+    fixed = low == problem.ubw[: problem.nx] * problem.state_scale
+    states[0, fixed] = low[fixed]  # node 0's fixed part: the keyframe at rest, or a rolling
+    # start's board and velocities (its pose is free)
     # Inputs of phases where a foot is now swinging are clipped to zero by the bounds.
     return Guess(states, inputs, None)
 

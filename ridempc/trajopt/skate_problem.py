@@ -135,6 +135,8 @@ class SkateOptions:
             0.9315-0.9925 m/s, 0.7 at 0.6659-0.7125, where it was 0.9119-0.9970 and
             0.6344-0.6904).
         speed_margin: Board speed bound as a multiple of the target [-].
+        start_speed: Speed of the board and rider at the start [m/s]: 0 from rest (an
+            ``accelerate`` entry), else a rolling board pushed again (a ``repush`` entry).
         w_speed: Weight of the board speed error [(m/s)^-2 s^-1].
         w_roll: Weight of the deck roll and roll rate.
         w_heading: Weight of the board's heading (the push should go straight).
@@ -166,6 +168,7 @@ class SkateOptions:
     touchdown_step: float = 0.005
     liftoff_force: float = 1.0
     speed_margin: float = 1.5
+    start_speed: float = 0.0
     w_speed: float = 10.0
     w_roll: float = 10.0
     w_heading: float = 10.0
@@ -197,6 +200,7 @@ def skate_schedule(robot: RigidBodyRobot, target: float, options: SkateOptions) 
         speed_per_stride=options.speed_per_stride,
         min_push=options.min_push,
         max_push=options.max_push,
+        start_speed=options.start_speed,
     )
 
 
@@ -224,8 +228,11 @@ def speed_bound(robot: RigidBodyRobot, options: SkateOptions, samples: int = 512
     return min(speed, (highest - lowest) / options.min_push)
 
 
-def initial_skate_state(robot: RigidBodyRobot, board: SkateboardModel) -> tuple[Array, Array]:
-    """Robot in its keyframe standing on the deck of a board at rest at the origin.
+def initial_skate_state(
+    robot: RigidBodyRobot, board: SkateboardModel, speed: float = 0.0
+) -> tuple[Array, Array]:
+    """Robot in its keyframe standing on the deck of a board at the origin, rolling along x
+    at ``speed`` [m/s] with it (at rest by default).
 
     Returns:
         The state (robot then board) and the deck-frame positions of the contact sites,
@@ -235,9 +242,11 @@ def initial_skate_state(robot: RigidBodyRobot, board: SkateboardModel) -> tuple[
     trunk_z = board.deck_height + float(np.mean(robot.foot_radius - feet[:, 2]))
     trunk = np.array([0.0, 0.0, trunk_z])
     com = trunk + robot.com_in_trunk
-    robot_state = np.concatenate([com, np.zeros(9), robot.q_reference])
+    robot_state = np.concatenate([com, np.zeros(3), [speed], np.zeros(5), robot.q_reference])
     on_deck = feet + trunk - np.array([0.0, 0.0, board.deck_height])
-    return np.concatenate([robot_state, np.zeros(len(BOARD_STATE))]), on_deck
+    board_state = np.zeros(len(BOARD_STATE))
+    board_state[BOARD_STATE.index("board_v")] = speed
+    return np.concatenate([robot_state, board_state]), on_deck
 
 
 def skate_rates(robot: RigidBodyRobot, board: SkateboardModel) -> ca.Function:
@@ -287,11 +296,11 @@ def _names(robot: RigidBodyRobot) -> tuple[tuple[str, ...], tuple[str, ...]]:
     return states, (*forces, *(f"qd_{j}" for j in robot.joints))
 
 
-def _node_specs(schedule: ContactSchedule, target: float) -> list[NodeSpec]:
+def _node_specs(schedule: ContactSchedule, target: float, start: float = 0.0) -> list[NodeSpec]:
     """Per node: which contact constraints apply (the signature: the feet's contacts, the
     interval's, the feet on the deck while another swings (in the interval before or after
     the node), last node, first node), the node where the pushing foot landed (the
-    reference) and the desired board speed (a ramp to the last push)."""
+    reference) and the desired board speed (a ramp from ``start`` to the last push)."""
     n = schedule.n_intervals
     contact_of = [schedule.phases[i].contacts for i in schedule.phase_of_interval()]
     phase_of = schedule.phase_of_interval()
@@ -339,7 +348,7 @@ def _node_specs(schedule: ContactSchedule, target: float) -> list[NodeSpec]:
                 support = tuple(i for i, kind in enumerate(c) if kind is Contact.BOARD)
         # Node 0 (its state fixed by its bounds) and the last node are groups of their own.
         signature = (tuple(feet), interval, support, k == n, k == 0)
-        speed = target * min(1.0, schedule.times[k] / ramp_end)
+        speed = start + (target - start) * min(1.0, schedule.times[k] / ramp_end)
         specs.append(NodeSpec(signature, landed if reference is None else reference, (speed,)))
     return specs
 
@@ -381,7 +390,7 @@ def build_skate_problem(
     state_scale = np.ones(nx)
     input_scale = np.concatenate([np.full(3 * nf, weight_per_foot), np.full(nj, 5.0)])
 
-    x0, on_deck_place = initial_skate_state(robot, board)
+    x0, on_deck_place = initial_skate_state(robot, board, o.start_speed)
     masks = schedule.contact_masks()
     deck_mask = masks[Contact.BOARD]
     rates = skate_rates(robot, board)
@@ -500,7 +509,7 @@ def build_skate_problem(
 
     metadata = {
         "pair": f"{robot.name}-skateboard",
-        "kind": "accelerate",
+        "kind": "repush" if o.start_speed > 0.0 else "accelerate",
         "target": float(target),
         "options": asdict(o),
         "phases": [
@@ -522,7 +531,7 @@ def build_skate_problem(
         parameters=deck_mask,
         state_bounds=(state_lo, state_hi),
         input_bounds=(-input_hi, input_hi),
-        nodes=_node_specs(schedule, target),
+        nodes=_node_specs(schedule, target, o.start_speed),
         node_terms=node_terms,
         metadata=metadata,
         started=started,
@@ -534,12 +543,14 @@ def skate_guess(
 ) -> tuple[Array, Array]:
     """A cold-start guess: the board on the speed ramp, the robot riding it in its keyframe,
     its weight shared by the feet in contact, joints still."""
-    x0, _ = initial_skate_state(robot, board)
+    options = SkateOptions(**problem.metadata["options"])
+    x0, _ = initial_skate_state(robot, board, options.start_speed)
     n = problem.n_intervals
     times = problem.times
     target = float(problem.metadata["target"])
     nr = 12 + robot.n_joints
-    speed = target * np.clip(times / times[-1] * 1.2, 0.0, 1.0)
+    start = options.start_speed
+    speed = start + (target - start) * np.clip(times / times[-1] * 1.2, 0.0, 1.0)
     position = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(times))])
     states = np.tile(x0, (n + 1, 1))
     states[:, 0] += position
@@ -547,7 +558,6 @@ def skate_guess(
     states[:, nr] = position
     states[:, nr + 3] = speed
     inputs = np.zeros((n, problem.nu))
-    options = SkateOptions(**problem.metadata["options"])
     masks = skate_schedule(robot, target, options).contact_masks()
     active = masks[Contact.BOARD] + masks[Contact.GROUND]
     for k in range(n):
