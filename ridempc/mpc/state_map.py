@@ -63,6 +63,10 @@ ALONG_SLACK: float = 0.1  # [m] the board's offset along the reference's line is
 # [s] the followed ground's lag: a Hovershoe's 4 cm drop off a step is followed within a tenth
 # of a second, its 4 Hz pitch's bobbing of the decks averaged out
 GROUND_FILTER_S: float = 0.1
+# [m] a rise of the ground the frame follows: the platforms' estimated height moves by up to
+# 2.3 cm on level ground while a foot is off the deck (the dog's push-off), which is no terrain;
+# once beyond it, the whole rise is followed until it is back within half of it
+GROUND_DEADBAND_M: float = 0.03
 
 
 def _along(velocity: Array, yaw: float) -> float:
@@ -181,6 +185,7 @@ class StateMap:
         self._rates: dict[str, _AngleRate] = {}
         self._heading_time = 0.0
         self._deck_start: float | None = None  # [m] the platforms' first height
+        self._on_terrain = False  # the rise is beyond GROUND_DEADBAND_M (hysteresis)
         self._ground_time = 0.0
         self.ground_rate = 0.0  # [m/s] the followed ground's rise rate
         self._fill = [self._filler(name) for name in self.names]
@@ -206,6 +211,7 @@ class StateMap:
     def reset(self) -> None:
         self.frame = PlanarFrame()
         self._deck_start = None
+        self._on_terrain = False
         self._ground_time = 0.0
         self.ground_rate = 0.0
         self._rates = {}
@@ -418,11 +424,11 @@ class StateMap:
         steps stretched her legs after the shoes (stairs-79-93-93 fell at the third step).
 
         The rise is the platforms' mean estimated height (the feet's, from the IMU and the
-        kinematics: no height map) over the first one seen, low-passed over
-        ``GROUND_FILTER_S``; its rate, the platforms' mean vertical velocity low-passed the
-        same way, comes off the centre of mass's (:meth:`state`), so that a rider rolling
-        down a slope is not asked to stop sinking with it. Without a board estimate nothing
-        changes.
+        kinematics: no height map) over the first one seen, followed once beyond
+        ``GROUND_DEADBAND_M`` and low-passed over ``GROUND_FILTER_S``; its rate, the
+        platforms' mean vertical velocity low-passed the same way, comes off the centre of
+        mass's (:meth:`state`), so that a rider rolling down a slope is not asked to stop
+        sinking with it. Without a board estimate nothing changes.
 
         Returns:
             The frame's height :math:`\\Delta p_z` [m].
@@ -434,8 +440,16 @@ class StateMap:
             self._deck_start, self._ground_time = deck, estimate.time
         share = min(1.0, max(0.0, estimate.time - self._ground_time) / GROUND_FILTER_S)
         self._ground_time = estimate.time
-        height = self.frame.height + share * (deck - self._deck_start - self.frame.height)
-        sinking = sum(float(b.velocity[2]) for b in estimate.boards) / len(estimate.boards)
+        rise = deck - self._deck_start
+        if abs(rise) > GROUND_DEADBAND_M:
+            self._on_terrain = True
+        elif abs(rise) < 0.5 * GROUND_DEADBAND_M:
+            self._on_terrain = False
+        followed = rise if self._on_terrain else 0.0
+        height = self.frame.height + share * (followed - self.frame.height)
+        sinking = 0.0
+        if self._on_terrain:
+            sinking = sum(float(b.velocity[2]) for b in estimate.boards) / len(estimate.boards)
         self.ground_rate += share * (sinking - self.ground_rate)
         self.frame = PlanarFrame(self.frame.yaw, self.frame.offset, height)
         return height
