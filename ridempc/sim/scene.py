@@ -10,6 +10,7 @@ can change their friction.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -207,6 +208,7 @@ def build_scene(
     dead_weight: float | None = None,
     foot_offset: tuple[float, float] = (0.0, 0.0),
     platform_offsets: tuple[tuple[float, float], ...] = (),
+    edit_spec: Callable[[mujoco.MjSpec], None] | None = None,
 ) -> Scene:
     """Compile a rider on a board (or on flat ground) in a settled initial state.
 
@@ -218,6 +220,8 @@ def build_scene(
         foot_offset: Feet (or weight) offset from the platform centre, (x, y) [m].
         platform_offsets: Per independent platform, a further shift of that platform, (x, y)
             [m] (Hovershoes started staggered).
+        edit_spec: Called with the model spec before it is compiled, to add to the scene
+            (a course's obstacles, a camera on the rider).
 
     The rider's feet go over the board's platform site(s): a rigid board puts the centroid
     of all feet over its one platform; independent platforms (Hovershoes) each move under
@@ -229,6 +233,8 @@ def build_scene(
     for key in list(spec.keys):
         spec.delete(key)
     _add_world(spec, physics_hz)
+    if edit_spec is not None:
+        edit_spec(spec)
     if robot is not None:
         add_imu_sensors(spec, robot.params.imu_site)
         rider_names = [robot.params.base_body]
