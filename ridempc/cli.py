@@ -251,6 +251,7 @@ def _list() -> int:
     print("distributions (what a sweep draws; a .toml path too):")
     for name in distribution_names():
         print(f"  {name:<16} boards: {', '.join(distribution_boards(name))}")
+    navigate_cli.list_courses()
     return 0
 
 

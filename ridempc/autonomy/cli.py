@@ -12,7 +12,7 @@ from typing import Any
 
 from ridempc import options
 
-__all__ = ["add_parser", "run", "unwritten"]
+__all__ = ["add_parser", "list_courses", "run", "unwritten"]
 
 CAMERA_MODES = ("raycast", "render")
 
@@ -60,6 +60,18 @@ def add_parser(commands: Any) -> None:
     nav.add_argument(
         "--json", type=options.path, default=None, help="with --bench: also write the results here"
     )
+
+
+def list_courses() -> None:
+    """Name the library's courses (for ``ridempc list``)."""
+    from ridempc.autonomy.course import course_names, resolve_course
+
+    print("courses (ridempc navigate --course; a .toml path too):")
+    for name in course_names():
+        course = resolve_course(name)
+        riders = ", ".join(course.robots) or "any"
+        boards = ", ".join(course.boards) or "any"
+        print(f"  {name:<16} boards: {boards}; riders: {riders}; {course.description}")
 
 
 def unwritten(args: argparse.Namespace) -> str:

@@ -39,6 +39,18 @@ class Costmap:
         self.cost = cost
         self.distance = distance
 
+    def coarsened(self, factor: int) -> Costmap:
+        """The costmap on cells ``factor`` times larger: each the most expensive (and the
+        closest to an obstacle) of the cells it covers, so no lethal cell is lost."""
+        if factor == 1:
+            return self
+        nx, ny = (n // factor for n in self.cost.shape)
+        blocks = (nx, factor, ny, factor)
+        cost = self.cost[: nx * factor, : ny * factor].reshape(blocks).max(axis=(1, 3))
+        distance = self.distance[: nx * factor, : ny * factor].reshape(blocks).min(axis=(1, 3))
+        frame = GridFrame(self.frame.origin, self.frame.resolution * factor, (nx, ny))
+        return Costmap(frame, cost, distance)
+
     def lethal_at(self, xy: Array) -> bool:
         """Whether the world point (x, y) [m] lies in a lethal cell (outside counts so)."""
         ij, inside = self.frame.cells(np.asarray(xy, dtype=float).reshape(1, 2))

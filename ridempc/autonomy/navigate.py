@@ -94,6 +94,7 @@ def check_reachable(course: Course, where: str, settings: NavigatorSettings) -> 
     """
     frame = map_frame(course)
     costmap = inflate(frame, rasterise(frame, course.obstacles), settings.inscribed, settings.decay)
+    costmap = costmap.coarsened(settings.global_coarsening)
     try:
         return plan(costmap, np.asarray(course.start[:2]), np.asarray(course.goal))
     except NoPath as exc:

@@ -26,13 +26,13 @@ from ridempc.autonomy.camera import CameraIntrinsics
 from ridempc.autonomy.costmap import Costmap, inflate
 from ridempc.autonomy.depth_sensor import DepthSensor, mount_pose
 from ridempc.autonomy.dijkstra import NoPath, plan
-from ridempc.autonomy.occupancy import OccupancyGrid
+from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import Perception
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner, TebSettings
 from ridempc.controllers.base import Controller
 from ridempc.scenarios.scenario import Command
 
-__all__ = ["Navigator", "NavigatorSettings"]
+__all__ = ["Navigator", "NavigatorSettings", "nearby_cells"]
 
 Array = NDArray[np.float64]
 
@@ -47,9 +47,14 @@ class NavigatorSettings:
         start_delay: Standing time before the rider sets off [s] (the riders settle).
         accel: Speed command's rate limit [m/s^2].
         yaw_accel: Yaw-rate command's rate limit [rad/s^2].
+        turn_at_rest: Largest yaw rate commanded at a standstill [rad/s]; the riders turn
+            by leaning and steer the shoes apart, so a yaw rate needs speed.
+        turn_radius: Beyond ``turn_at_rest``, the yaw rate is at most speed over this [m].
         stop_decel: Deceleration of a stop [m/s^2].
         inscribed: Rider's inscribed radius in the costmap [m] (Cassie's stance on the shoes).
         decay: Costmap decay rate [1/m].
+        global_coarsening: The global planner's cells are this many map cells wide (10 cm:
+            the band refines the path; a quarter of the cells, a quarter of the time).
         arrive: Distance to the goal at which the rider stops [m].
         approach_gain: Speed per metre to the goal near it [1/s] (it arrives, not overshoots).
         failures_to_stop: Band failures in a row that stop the rider.
@@ -61,10 +66,13 @@ class NavigatorSettings:
     global_hz: float = 1.0
     start_delay: float = 2.0
     accel: float = 0.4
-    yaw_accel: float = 1.5
+    yaw_accel: float = 0.8
+    turn_at_rest: float = 0.15
+    turn_radius: float = 0.6
     stop_decel: float = 0.5
     inscribed: float = 0.35
     decay: float = 3.0
+    global_coarsening: int = 2
     arrive: float = 0.1
     approach_gain: float = 0.8
     failures_to_stop: int = 3
@@ -201,8 +209,10 @@ class Navigator:
                 return
         local_goal = self._local_goal(base[:2])
         obstacles = self._nearby_obstacles(base[:2])
-        speed = float(self.command_at(t).velocity)
-        band = self.teb.solve(np.array([base[0], base[1], yaw]), local_goal, obstacles, speed)
+        now = self.command_at(t)
+        band = self.teb.solve(
+            np.array([base[0], base[1], yaw]), local_goal, obstacles, now.velocity, now.yaw_rate
+        )
         self.teb_times.append(band.solve_time)
         if not band.success:
             self.band_failures += 1
@@ -217,6 +227,8 @@ class Navigator:
         v = float(np.mean(speeds[:lead]))
         w = float(np.mean(yaw_rates[:lead]))
         v = max(0.0, min(v, self.settings.approach_gain * to_goal))
+        turn = self.settings.turn_at_rest + v / self.settings.turn_radius
+        w = float(np.clip(w, -turn, turn))
         self._decel = self.settings.accel
         self._retarget(t, v, w)
 
@@ -224,6 +236,7 @@ class Navigator:
         s = self.settings
         began = time.perf_counter()
         costmap = inflate(self.grid.frame, self.grid.occupied(), s.inscribed, s.decay)
+        costmap = costmap.coarsened(s.global_coarsening)
         self.costmap = costmap
         try:
             path = plan(costmap, _free_start(costmap, start), self.goal)
@@ -251,18 +264,9 @@ class Navigator:
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        frame = self.grid.frame
-        occupied = self.grid.occupied()
-        if not occupied.any():
-            return np.zeros((0, 2))
-        i, j = np.nonzero(occupied)
-        xy = np.column_stack(
-            [
-                frame.origin[0] + (i + 0.5) * frame.resolution,
-                frame.origin[1] + (j + 0.5) * frame.resolution,
-            ]
+        return nearby_cells(
+            self.grid.frame, self.grid.occupied(), position, self.settings.obstacle_radius
         )
-        return xy[np.linalg.norm(xy - position, axis=1) <= self.settings.obstacle_radius]
 
     def _stop(self, t: float, reason: str) -> None:
         self.stopped_at = t
@@ -284,6 +288,20 @@ class Navigator:
             "global_plans": len(self.global_times),
             "frames_fused": len(self.perception_times),
         }
+
+
+def nearby_cells(
+    frame: GridFrame, occupied: NDArray[np.bool_], position: Array, radius: float
+) -> Array:
+    """Centres (x, y) [m] of the occupied cells within ``radius`` [m] of ``position``."""
+    i, j = np.nonzero(occupied)
+    xy = np.column_stack(
+        [
+            frame.origin[0] + (i + 0.5) * frame.resolution,
+            frame.origin[1] + (j + 0.5) * frame.resolution,
+        ]
+    )
+    return xy[np.linalg.norm(xy - position, axis=1) <= radius]
 
 
 def _free_start(costmap: Costmap, start: Array) -> Array:

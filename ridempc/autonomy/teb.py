@@ -10,15 +10,17 @@ The band is :math:`N` poses :math:`s_i = (x_i, y_i, \\theta_i)` and the :math:`N
     + w_{b} \\sum_i \\max(0, -\\Delta x_i \\cos\\theta_i - \\Delta y_i \\sin\\theta_i)^2
     + w_{r} \\sum_i \\max(0, r_{min} |\\Delta\\theta_i| - \\lVert \\Delta p_i \\rVert)^2
     + w_{o} \\sum_{i, k} \\max(0, d_{min} - d(\\overline{p_i p_{i+1}}, o_k))^2
-    + w_{a} \\sum_i (v_{i+1} - v_i)^2
+    + w_{a} \\sum_i (v_{i+1} - v_i)^2 + w_{\\omega} \\sum_i (\\omega_{i+1} - \\omega_i)^2
 
 (time; the non-holonomic arc condition, the shoes move along their heading; forward
 driving; a car-like turning radius; the distance of each obstacle point :math:`o_k` to
-each *segment* of the band, not only to its poses; smooth speeds), subject to
+each *segment* of the band, not only to its poses; smooth speeds and turns, from the
+current ones), subject to
 :math:`\\lVert \\Delta p_i \\rVert \\le v_{max} \\Delta T_i` and
-:math:`|\\Delta\\theta_i| \\le \\omega_{max} \\Delta T_i`. The NLP is built once with the
-start, goal and obstacles as parameters and solved by IPOPT, warm-started from the last
-band. The band's first segments give the riding controller its speed and yaw-rate command.
+:math:`|\\Delta\\theta_i| \\le \\omega_{max} \\Delta T_i` and forward motion. The NLP is
+built once with the start, goal and obstacles as parameters and solved by IPOPT,
+warm-started from the last band. The band's first two segments give the riding controller
+its speed and yaw-rate command.
 """
 
 from __future__ import annotations
@@ -56,20 +58,22 @@ class TebSettings:
         w_radius: Weight of turning tighter than ``r_min``.
         w_obstacle: Weight of an obstacle within ``d_min``.
         w_speed_change: Weight of speed changes between segments.
+        w_turn_change: Weight of yaw-rate changes between segments.
         max_iter: IPOPT iterations per update.
     """
 
     poses: int = 10
     v_max: float = 0.6
-    omega_max: float = 0.6
+    omega_max: float = 0.5
     d_min: float = 0.5
-    r_min: float = 0.3
+    r_min: float = 0.6
     obstacles: int = 30
     w_nonholonomic: float = 1000.0
-    w_backward: float = 100.0
-    w_radius: float = 10.0
+    w_backward: float = 1000.0
+    w_radius: float = 50.0
     w_obstacle: float = 200.0
     w_speed_change: float = 2.0
+    w_turn_change: float = 1.0
     max_iter: int = 40
 
 
@@ -118,15 +122,16 @@ class TebPlanner:
     def __init__(self, settings: TebSettings | None = None) -> None:
         self.settings = s = settings or TebSettings()
         n, k = s.poses, s.obstacles
-        x = ca.MX.sym("x", 3, n)
-        dt = ca.MX.sym("dt", n - 1)
-        start = ca.MX.sym("start", 3)
-        goal = ca.MX.sym("goal", 3)
-        obstacles = ca.MX.sym("obstacles", 2, k)
-        speed0 = ca.MX.sym("speed0")
+        x = ca.SX.sym("x", 3, n)
+        dt = ca.SX.sym("dt", n - 1)
+        start = ca.SX.sym("start", 3)
+        goal = ca.SX.sym("goal", 3)
+        obstacles = ca.SX.sym("obstacles", 2, k)
+        speed0 = ca.SX.sym("speed0")
+        turn0 = ca.SX.sym("turn0")
         cost = ca.sum1(dt)
         g, lbg, ubg = [x[:, 0] - start, x[:2, n - 1] - goal[:2]], [0.0] * 5, [0.0] * 5
-        speeds = []
+        speeds, turns = [], []
         for i in range(n - 1):
             dx, dy = x[0, i + 1] - x[0, i], x[1, i + 1] - x[1, i]
             dth = x[2, i + 1] - x[2, i]
@@ -138,9 +143,15 @@ class TebPlanner:
             length = ca.sqrt(dx**2 + dy**2 + 1e-9)
             cost += s.w_radius * ca.fmax(0.0, s.r_min * ca.fabs(dth) - length) ** 2
             speeds.append(forward / dt[i])
-            g += [length - s.v_max * dt[i], dth - s.omega_max * dt[i], -dth - s.omega_max * dt[i]]
-            lbg += [-ca.inf] * 3
-            ubg += [0.0] * 3
+            turns.append(dth / dt[i])
+            g += [
+                length - s.v_max * dt[i],
+                dth - s.omega_max * dt[i],
+                -dth - s.omega_max * dt[i],
+                -forward,  # the shoes ride forwards
+            ]
+            lbg += [-ca.inf] * 4
+            ubg += [0.0] * 4
             a = x[:2, i]
             ab = x[:2, i + 1] - a
             ao = obstacles - ca.repmat(a, 1, k)
@@ -150,10 +161,12 @@ class TebPlanner:
             cost += s.w_obstacle * ca.sumsqr(ca.fmax(0.0, s.d_min - d))
         for i in range(n - 2):
             cost += s.w_speed_change * (speeds[i + 1] - speeds[i]) ** 2
+            cost += s.w_turn_change * (turns[i + 1] - turns[i]) ** 2
         cost += s.w_speed_change * (speeds[0] - speed0) ** 2
+        cost += s.w_turn_change * (turns[0] - turn0) ** 2
         cost += 10.0 * (1.0 - ca.cos(x[2, n - 1] - goal[2]))
         variables = ca.veccat(x, dt)
-        parameters = ca.veccat(start, goal, obstacles, speed0)
+        parameters = ca.veccat(start, goal, obstacles, speed0, turn0)
         self._solver = ca.nlpsol(
             "teb",
             "ipopt",
@@ -195,10 +208,12 @@ class TebPlanner:
         dt = np.full(n - 1, max(0.05, distance / (n - 1) / (0.8 * self.settings.v_max)))
         return poses, dt
 
-    def solve(self, start: Array, goal: Array, obstacles: Array, speed: float = 0.0) -> Band:
+    def solve(
+        self, start: Array, goal: Array, obstacles: Array, speed: float = 0.0, turn: float = 0.0
+    ) -> Band:
         """The band from ``start`` to ``goal`` (x, y, theta) [m, m, rad] past ``obstacles``
         (world (x, y) [m], the nearest ``settings.obstacles`` are used), starting at forward
-        ``speed`` [m/s]."""
+        ``speed`` [m/s] and yaw rate ``turn`` [rad/s]."""
         s = self.settings
         start = np.asarray(start, dtype=float)
         goal = np.asarray(goal, dtype=float).copy()
@@ -210,7 +225,7 @@ class TebPlanner:
             order = np.argsort(np.linalg.norm(obstacles[:, :2] - middle, axis=1))
             chosen = obstacles[order[: s.obstacles], :2]
             slots[:, : len(chosen)] = chosen.T
-        p = np.concatenate([start, goal, slots.T.reshape(-1), [speed]])
+        p = np.concatenate([start, goal, slots.T.reshape(-1), [speed, turn]])
         began = time.perf_counter()
         result = self._solver(
             x0=np.concatenate([poses.reshape(-1), dt]),

@@ -27,8 +27,10 @@ def voxel_filter(points: Array, size: tuple[float, float, float] = VOXEL_SIZE) -
     if len(points) == 0:
         return np.zeros((0, 3))
     keys = np.floor(points / np.asarray(size)).astype(np.int64)
-    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
-    sums = np.zeros((len(counts), 3))
-    np.add.at(sums, inverse, points)
+    keys -= keys.min(axis=0)
+    flat = np.ravel_multi_index(keys.T, tuple(keys.max(axis=0) + 1))  # one integer per voxel
+    _, inverse, counts = np.unique(flat, return_inverse=True, return_counts=True)
+    sums = np.column_stack(
+        [np.bincount(inverse, weights=points[:, k], minlength=len(counts)) for k in range(3)]
+    )
     return sums / counts[:, None]
