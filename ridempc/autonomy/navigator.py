@@ -66,7 +66,7 @@ class NavigatorSettings:
     global_hz: float = 1.0
     start_delay: float = 2.0
     accel: float = 0.4
-    yaw_accel: float = 0.8
+    yaw_accel: float = 0.5
     turn_at_rest: float = 0.15
     turn_radius: float = 0.6
     stop_decel: float = 0.5
