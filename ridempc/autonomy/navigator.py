@@ -59,6 +59,8 @@ class NavigatorSettings:
         approach_gain: Speed per metre to the goal near it [1/s] (it arrives, not overshoots).
         failures_to_stop: Band failures in a row that stop the rider.
         obstacle_radius: Map cells within this distance are the band's obstacles [m].
+        command_horizon: The command is the band's mean speed and yaw rate over its first
+            this many seconds [s] (the riders lag their command by about that much).
         teb: The band's settings.
     """
 
@@ -77,6 +79,7 @@ class NavigatorSettings:
     approach_gain: float = 0.8
     failures_to_stop: int = 3
     obstacle_radius: float = 2.5
+    command_horizon: float = 0.5
     teb: TebSettings = field(default_factory=TebSettings)
 
 
@@ -222,10 +225,7 @@ class Navigator:
             return
         self._failures_in_row = 0
         self.bands.append(band.poses)
-        speeds, yaw_rates = band.speeds()
-        lead = min(len(speeds), 2)  # the first 2 segments: about the next 0.3 s
-        v = float(np.mean(speeds[:lead]))
-        w = float(np.mean(yaw_rates[:lead]))
+        v, w = band.command(self.settings.command_horizon)
         v = max(0.0, min(v, self.settings.approach_gain * to_goal))
         turn = self.settings.turn_at_rest + v / self.settings.turn_radius
         w = float(np.clip(w, -turn, turn))

@@ -19,7 +19,7 @@ current ones), subject to
 :math:`\\lVert \\Delta p_i \\rVert \\le v_{max} \\Delta T_i` and
 :math:`|\\Delta\\theta_i| \\le \\omega_{max} \\Delta T_i` and forward motion. The NLP is
 built once with the start, goal and obstacles as parameters and solved by IPOPT,
-warm-started from the last band. The band's first two segments give the riding controller
+warm-started from the last band. The band's first half second gives the riding controller
 its speed and yaw-rate command.
 """
 
@@ -92,6 +92,16 @@ class Band:
     dt: Array
     success: bool
     solve_time: float
+
+    def command(self, horizon: float) -> tuple[float, float]:
+        """Mean forward speed [m/s] and yaw rate [rad/s] over the band's first ``horizon``
+        seconds (at least its first segment)."""
+        speeds, turns = self.speeds()
+        times = np.concatenate([[0.0], np.cumsum(self.dt)])
+        within = np.clip(np.minimum(times[1:], horizon) - times[:-1], 0.0, None)
+        within[0] = max(within[0], 1e-9)
+        weights = within / within.sum()
+        return float(weights @ speeds), float(weights @ turns)
 
     def speeds(self) -> tuple[Array, Array]:
         """Forward speed [m/s] and yaw rate [rad/s] of each segment."""
@@ -193,19 +203,29 @@ class TebPlanner:
         self._last = None
 
     def _guess(self, start: Array, goal: Array) -> tuple[Array, Array]:
-        n = self.settings.poses
+        """The last band from the pose nearest the rider on (the poses it has passed are
+        dropped) to the new goal, resampled to ``N`` poses evenly along its length; a
+        straight line when there is no last band or its goal moved far."""
+        n, v_max = self.settings.poses, self.settings.v_max
         last = self._last
         if last is not None and np.linalg.norm(last.poses[-1, :2] - goal[:2]) < 1.0:
-            poses = last.poses.copy()
-            poses[0] = start
-            poses[-1, :2] = goal[:2]
-            return poses, last.dt.copy()
+            nearest = int(np.argmin(np.linalg.norm(last.poses[:, :2] - start[:2], axis=1)))
+            chain = np.vstack([start, last.poses[nearest + 1 : -1], goal])
+            chain[:, 2] = start[2] + np.unwrap(chain[:, 2] - start[2])
+            arc = np.concatenate(
+                [[0.0], np.cumsum(np.linalg.norm(np.diff(chain[:, :2], axis=0), axis=1))]
+            )
+            if arc[-1] > 1e-3:
+                at = np.linspace(0.0, arc[-1], n)
+                poses = np.column_stack([np.interp(at, arc, chain[:, k]) for k in range(3)])
+                speed = float(np.clip(np.mean(np.abs(last.speeds()[0])), 0.2 * v_max, v_max))
+                return poses, np.full(n - 1, max(0.02, arc[-1] / (n - 1) / speed))
         alpha = np.linspace(0.0, 1.0, n)[:, None]
         poses = (1.0 - alpha) * start[None, :] + alpha * goal[None, :]
         heading = math.atan2(goal[1] - start[1], goal[0] - start[0])
         poses[1:-1, 2] = start[2] + _wrap(heading - start[2])
         distance = float(np.linalg.norm(goal[:2] - start[:2]))
-        dt = np.full(n - 1, max(0.05, distance / (n - 1) / (0.8 * self.settings.v_max)))
+        dt = np.full(n - 1, max(0.05, distance / (n - 1) / (0.8 * v_max)))
         return poses, dt
 
     def solve(
