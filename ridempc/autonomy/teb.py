@@ -11,11 +11,12 @@ The band is :math:`N` poses :math:`s_i = (x_i, y_i, \\theta_i)` and the :math:`N
     + w_{r} \\sum_i \\max(0, r_{min} |\\Delta\\theta_i| - \\lVert \\Delta p_i \\rVert)^2
     + w_{o} \\sum_{i, k} \\max(0, d_{min} - d(\\overline{p_i p_{i+1}}, o_k))^2
     + w_{a} \\sum_i (v_{i+1} - v_i)^2 + w_{\\omega} \\sum_i (\\omega_{i+1} - \\omega_i)^2
+    + w_{e} \\sum_i (\\Delta T_{i+1} - \\Delta T_i)^2
 
 (time; the non-holonomic arc condition, the shoes move along their heading; forward
 driving; a car-like turning radius; the distance of each obstacle point :math:`o_k` to
 each *segment* of the band, not only to its poses; smooth speeds and turns, from the
-current ones), subject to
+current ones; evenly spaced times), subject to
 :math:`\\lVert \\Delta p_i \\rVert \\le v_{max} \\Delta T_i` and
 :math:`|\\Delta\\theta_i| \\le \\omega_{max} \\Delta T_i` and forward motion. The NLP is
 built once with the start, goal and obstacles as parameters and solved by IPOPT,
@@ -59,6 +60,8 @@ class TebSettings:
         w_obstacle: Weight of an obstacle within ``d_min``.
         w_speed_change: Weight of speed changes between segments.
         w_turn_change: Weight of yaw-rate changes between segments.
+        w_even: Weight of unequal times between poses (keeps the band evenly discretised,
+            not squeezed to the shortest steps at one end and stretched at the other).
         max_iter: IPOPT iterations per update.
     """
 
@@ -74,6 +77,7 @@ class TebSettings:
     w_obstacle: float = 200.0
     w_speed_change: float = 2.0
     w_turn_change: float = 1.0
+    w_even: float = 10.0
     max_iter: int = 40
 
 
@@ -172,6 +176,7 @@ class TebPlanner:
         for i in range(n - 2):
             cost += s.w_speed_change * (speeds[i + 1] - speeds[i]) ** 2
             cost += s.w_turn_change * (turns[i + 1] - turns[i]) ** 2
+            cost += s.w_even * (dt[i + 1] - dt[i]) ** 2
         cost += s.w_speed_change * (speeds[0] - speed0) ** 2
         cost += s.w_turn_change * (turns[0] - turn0) ** 2
         cost += 10.0 * (1.0 - ca.cos(x[2, n - 1] - goal[2]))
