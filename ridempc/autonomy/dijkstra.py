@@ -25,7 +25,7 @@ __all__ = ["COST_WEIGHT", "NoPath", "plan", "plan_heapq"]
 
 Array = NDArray[np.float64]
 
-COST_WEIGHT: float = 5.0  # a cell next to the inscribed radius costs as much as 6 free ones
+COST_WEIGHT: float = 2.0  # a cell next to the inscribed radius costs as much as 3 free ones
 _NEIGHBOURS = ((1, 0), (0, 1), (1, 1), (1, -1))  # each undirected edge once
 
 

@@ -231,7 +231,7 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
     }
     if out is None:
         return summary
-    atomic_write_npz(out / "log.npz", result.log)
+    atomic_write_npz(out / "log.npz", {**result.log, **navigator.trace_arrays()})
     files = ["log.npz"]
     if video is not None and video.frames:
         files.append("video.mp4")

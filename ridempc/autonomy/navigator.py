@@ -53,6 +53,8 @@ class NavigatorSettings:
         stop_decel: Deceleration of a stop [m/s^2].
         inscribed: Rider's inscribed radius in the costmap [m] (Cassie's stance on the shoes).
         decay: Costmap decay rate [1/m].
+        unknown_cost: Cost added to the cells never seen: a path through known free space
+            is preferred to a shorter one through the unknown, unless much shorter.
         global_coarsening: The global planner's cells are this many map cells wide (10 cm:
             the band refines the path; a quarter of the cells, a quarter of the time).
         arrive: Distance to the goal at which the rider stops [m].
@@ -67,14 +69,15 @@ class NavigatorSettings:
     planner_hz: float = 10.0
     global_hz: float = 1.0
     start_delay: float = 2.0
-    accel: float = 0.4
-    yaw_accel: float = 0.5
-    turn_at_rest: float = 0.15
-    turn_radius: float = 0.6
+    accel: float = 0.25
+    yaw_accel: float = 0.3
+    turn_at_rest: float = 0.1
+    turn_radius: float = 1.0
     stop_decel: float = 0.5
     inscribed: float = 0.35
     decay: float = 3.0
     global_coarsening: int = 2
+    unknown_cost: float = 0.3
     arrive: float = 0.1
     approach_gain: float = 0.8
     failures_to_stop: int = 3
@@ -133,6 +136,7 @@ class Navigator:
         self.global_times: list[float] = []
         self.perception_times: list[float] = []
         self.bands: list[Array] = []
+        self.trace: list[tuple[float, float, float, float, float, float]] = []
 
     # -- what the riding controller reads ---------------------------------------------------
     def command_at(self, t: float) -> Command:
@@ -226,6 +230,7 @@ class Navigator:
         self._failures_in_row = 0
         self.bands.append(band.poses)
         v, w = band.command(self.settings.command_horizon)
+        self.trace.append((t, v, w, *local_goal))
         v = max(0.0, min(v, self.settings.approach_gain * to_goal))
         turn = self.settings.turn_at_rest + v / self.settings.turn_radius
         w = float(np.clip(w, -turn, turn))
@@ -236,6 +241,7 @@ class Navigator:
         s = self.settings
         began = time.perf_counter()
         costmap = inflate(self.grid.frame, self.grid.occupied(), s.inscribed, s.decay)
+        costmap.cost[~self.grid.observed] += s.unknown_cost
         costmap = costmap.coarsened(s.global_coarsening)
         self.costmap = costmap
         try:
@@ -267,6 +273,16 @@ class Navigator:
         return nearby_cells(
             self.grid.frame, self.grid.occupied(), position, self.settings.obstacle_radius
         )
+
+    def trace_arrays(self) -> dict[str, Array]:
+        """Every band's time [s], command (speed [m/s], yaw rate [rad/s]) and local goal
+        (x, y [m], heading [rad]), for ``log.npz``."""
+        trace = np.array(self.trace).reshape(-1, 6)
+        return {
+            "planner_time": trace[:, 0],
+            "planner_command": trace[:, 1:3],
+            "planner_local_goal": trace[:, 3:],
+        }
 
     def _stop(self, t: float, reason: str) -> None:
         self.stopped_at = t

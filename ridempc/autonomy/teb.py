@@ -66,7 +66,7 @@ class TebSettings:
     """
 
     poses: int = 10
-    v_max: float = 0.6
+    v_max: float = 0.5
     omega_max: float = 0.35
     d_min: float = 0.5
     r_min: float = 0.6
