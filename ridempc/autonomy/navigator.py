@@ -59,6 +59,9 @@ class NavigatorSettings:
             the band refines the path; a quarter of the cells, a quarter of the time).
         arrive: Distance to the goal at which the rider stops [m].
         approach_gain: Speed per metre to the goal near it [1/s] (it arrives, not overshoots).
+        hold_gain: At the goal, speed per metre of the goal ahead (behind: negative) [1/s]:
+            the riders creep a few centimetres a second when told to stand still.
+        hold_speed: Largest speed of that hold [m/s].
         failures_to_stop: Band failures in a row that stop the rider.
         obstacle_radius: Map cells within this distance are the band's obstacles [m].
         command_horizon: The command is the band's mean speed and yaw rate over its first
@@ -80,6 +83,8 @@ class NavigatorSettings:
     unknown_cost: float = 0.3
     arrive: float = 0.1
     approach_gain: float = 0.8
+    hold_gain: float = 0.5
+    hold_speed: float = 0.1
     failures_to_stop: int = 3
     obstacle_radius: float = 2.5
     command_horizon: float = 0.5
@@ -199,15 +204,18 @@ class Navigator:
     def _plan(self, tick: int, t: float) -> None:
         self._perceive(t)
         pose = self._pose()
-        if pose is None or self.stopped_at is not None or self.arrived_at is not None:
+        if pose is None or self.stopped_at is not None:
             return
         base, rotation = pose
         yaw = math.atan2(rotation[1, 0], rotation[0, 0])
         to_goal = float(np.hypot(*(self.goal - base[:2])))
-        if to_goal <= self.settings.arrive:
+        if self.arrived_at is None and to_goal <= self.settings.arrive:
             self.arrived_at = t
             self._decel = self.settings.stop_decel
-            self._retarget(t, 0.0, 0.0)
+        if self.arrived_at is not None:  # hold at the goal: a rider left alone creeps
+            ahead = float((self.goal - base[:2]) @ rotation[:2, 0])
+            hold = self.settings.hold_speed
+            self._retarget(t, float(np.clip(self.settings.hold_gain * ahead, -hold, hold)), 0.0)
             return
         if t < self.settings.start_delay:
             return
