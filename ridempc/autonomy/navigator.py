@@ -76,13 +76,13 @@ class NavigatorSettings:
     yaw_accel: float = 0.3
     turn_at_rest: float = 0.1
     turn_radius: float = 1.0
-    stop_decel: float = 0.5
+    stop_decel: float = 0.25
     inscribed: float = 0.35
     decay: float = 3.0
     global_coarsening: int = 2
     unknown_cost: float = 0.3
     arrive: float = 0.1
-    approach_gain: float = 0.8
+    approach_gain: float = 0.5
     hold_gain: float = 0.5
     hold_speed: float = 0.1
     failures_to_stop: int = 3
