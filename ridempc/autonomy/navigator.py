@@ -81,7 +81,7 @@ class NavigatorSettings:
     decay: float = 3.0
     global_coarsening: int = 2
     unknown_cost: float = 0.3
-    arrive: float = 0.1
+    arrive: float = 0.2
     approach_gain: float = 0.5
     hold_gain: float = 0.5
     hold_speed: float = 0.1
