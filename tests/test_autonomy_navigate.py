@@ -117,7 +117,7 @@ def test_a_failing_planner_stops_the_rider_and_holds(monkeypatch: pytest.MonkeyP
     _ride(navigator, 4.0)
     failed = Band(np.zeros((10, 3)), np.ones(9), success=False, solve_time=0.0)
     monkeypatch.setattr(navigator.teb, "solve", lambda *args, **kwargs: failed)
-    commands = _ride_on(navigator, 4.0, 11.0)  # 0.5 m/s stops in 5 s at 0.1 m/s^2
+    commands = _ride_on(navigator, 4.0, 8.0)
     s = navigator.settings
     assert navigator.band_failures == s.failures_to_stop
     assert navigator.stop_reason is not None and "failed 3 times" in navigator.stop_reason

@@ -45,9 +45,7 @@ class NavigatorSettings:
         planner_hz: Local planner rate [Hz] (the paper's 10).
         global_hz: Global replanning rate [Hz].
         start_delay: Standing time before the rider sets off [s] (the riders settle).
-        accel: Speed command's rate limit, rising [m/s^2].
-        decel: Speed command's rate limit, falling [m/s^2]: the MPC rider on the shoes
-            does not follow a speed falling at 0.25 m/s^2, and spins.
+        accel: Speed command's rate limit [m/s^2].
         yaw_accel: Yaw-rate command's rate limit [rad/s^2].
         turn_at_rest: Largest yaw rate commanded at a standstill [rad/s]; the riders turn
             by leaning and steer the shoes apart, so a yaw rate needs speed.
@@ -75,17 +73,16 @@ class NavigatorSettings:
     global_hz: float = 1.0
     start_delay: float = 2.0
     accel: float = 0.25
-    decel: float = 0.1
     yaw_accel: float = 0.3
     turn_at_rest: float = 0.1
     turn_radius: float = 1.0
-    stop_decel: float = 0.1
+    stop_decel: float = 0.25
     inscribed: float = 0.35
     decay: float = 3.0
     global_coarsening: int = 2
     unknown_cost: float = 0.3
     arrive: float = 0.2
-    approach_gain: float = 0.25
+    approach_gain: float = 0.5
     hold_gain: float = 0.5
     hold_speed: float = 0.1
     failures_to_stop: int = 3
@@ -134,7 +131,7 @@ class Navigator:
         self.costmap: Costmap | None = None
         self._command = (0.0, 0.0, 0.0)  # (time, speed, yaw rate) of the last command
         self._target = (0.0, 0.0)
-        self._decel = s.decel
+        self._decel = s.accel
         self._failures_in_row = 0
         self.arrived_at: float | None = None
         self.stopped_at: float | None = None
@@ -245,7 +242,7 @@ class Navigator:
         v = max(0.0, min(v, self.settings.approach_gain * to_goal))
         turn = self.settings.turn_at_rest + v / self.settings.turn_radius
         w = float(np.clip(w, -turn, turn))
-        self._decel = self.settings.decel
+        self._decel = self.settings.accel
         self._retarget(t, v, w)
 
     def _replan(self, start: Array, t: float) -> bool:
