@@ -104,3 +104,10 @@ def test_teb_warm_start_agrees_with_a_cold_start() -> None:
     assert again.success and cold.success
     assert again.dt.sum() == pytest.approx(cold.dt.sum(), rel=0.05)
     assert math.isfinite(again.clearance(wall))
+
+
+def test_teb_reports_a_failure_rather_than_raising() -> None:
+    band = TebPlanner().solve(
+        np.array([0.0, 0.0, 0.0]), np.array([np.nan, 0.0, 0.0]), np.zeros((0, 2))
+    )
+    assert not band.success

@@ -252,14 +252,18 @@ class TebPlanner:
             slots[:, : len(chosen)] = chosen.T
         p = np.concatenate([start, goal, slots.T.reshape(-1), [speed, turn]])
         began = time.perf_counter()
-        result = self._solver(
-            x0=np.concatenate([poses.reshape(-1), dt]),
-            p=p,
-            lbx=self._lbx,
-            ubx=self._ubx,
-            lbg=self._lbg,
-            ubg=self._ubg,
-        )
+        try:
+            result = self._solver(
+                x0=np.concatenate([poses.reshape(-1), dt]),
+                p=p,
+                lbx=self._lbx,
+                ubx=self._ubx,
+                lbg=self._lbg,
+                ubg=self._ubg,
+            )
+        except RuntimeError:  # CasADi's own error (a NaN in its evaluation): a failed band
+            self._last = None
+            return Band(poses, dt, success=False, solve_time=time.perf_counter() - began)
         elapsed = time.perf_counter() - began
         status = self._solver.stats()["return_status"]
         z = np.asarray(result["x"]).reshape(-1)
