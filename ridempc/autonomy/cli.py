@@ -93,6 +93,8 @@ def run(args: argparse.Namespace) -> int:
             writable_file(args.json, "--json file")
         bench_planners(args.course, json_path=args.json)
         return 0
+    if args.json is not None:
+        raise ConfigError("navigate: --json writes the --bench results; allowed: with --bench")
     if args.course is None:
         raise ConfigError("navigate: --course is required (a course name or .toml file)")
     if args.out is None:
