@@ -57,11 +57,15 @@ class NavigatorSettings:
             is preferred to a shorter one through the unknown, unless much shorter.
         global_coarsening: The global planner's cells are this many map cells wide (10 cm:
             the band refines the path; a quarter of the cells, a quarter of the time).
-        arrive: Distance to the goal at which the rider stops [m].
-        approach_gain: Speed per metre to the goal near it [1/s] (it arrives, not overshoots).
+        arrive: Distance to the goal at which the speed command steps to zero [m]: the
+            MPC rider's motion library stops from 0.5 m/s in 0.45 m (``stop-0.50``).
+        cruise: Speed the rider rides at [m/s] (the MPC's library rides at 0.5 m/s; it
+            holds any lower command that is not rest at that).
+        min_speed: Slowest speed commanded while riding [m/s]: the MPC rider starts its
+            stop manoeuvre when more than 0.25 m/s faster than its command.
         hold_gain: At the goal, speed per metre of the goal ahead (behind: negative) [1/s]:
             the riders creep a few centimetres a second when told to stand still.
-        hold_speed: Largest speed of that hold [m/s].
+        hold_speed: Largest speed of that hold [m/s], below the MPC's 0.05 m/s of rest.
         failures_to_stop: Band failures in a row that stop the rider.
         obstacle_radius: Map cells within this distance are the band's obstacles [m].
         command_horizon: The command is the band's mean speed and yaw rate over its first
@@ -81,10 +85,11 @@ class NavigatorSettings:
     decay: float = 3.0
     global_coarsening: int = 2
     unknown_cost: float = 0.3
-    arrive: float = 0.2
-    approach_gain: float = 0.5
+    arrive: float = 0.45
+    cruise: float = 0.5
+    min_speed: float = 0.3
     hold_gain: float = 0.5
-    hold_speed: float = 0.1
+    hold_speed: float = 0.04
     failures_to_stop: int = 3
     obstacle_radius: float = 2.5
     command_horizon: float = 0.5
@@ -210,6 +215,7 @@ class Navigator:
         yaw = math.atan2(rotation[1, 0], rotation[0, 0])
         to_goal = float(np.hypot(*(self.goal - base[:2])))
         if self.arrived_at is None and to_goal <= self.settings.arrive:
+            self._command = (t, 0.0, 0.0)  # a step: the riders brake as they were built to
             self.arrived_at = t
             self._decel = self.settings.stop_decel
         if self.arrived_at is not None:  # hold at the goal: a rider left alone creeps
@@ -239,7 +245,7 @@ class Navigator:
         self.bands.append(band.poses)
         v, w = band.command(self.settings.command_horizon)
         self.trace.append((t, v, w, *local_goal))
-        v = max(0.0, min(v, self.settings.approach_gain * to_goal))
+        v = max(self.settings.min_speed, min(v, self.settings.cruise))
         turn = self.settings.turn_at_rest + v / self.settings.turn_radius
         w = float(np.clip(w, -turn, turn))
         self._decel = self.settings.accel
