@@ -45,6 +45,7 @@ __all__ = ["NavigateRequest", "map_frame", "navigate"]
 Array = NDArray[np.float64]
 
 MAP_RESOLUTION: float = 0.05  # [m] the voxels' horizontal size
+REST_SPEED: float = 0.05  # [m/s] the MPC's own threshold of rest
 MAP_MARGIN: float = 3.0  # [m] around the course's start, goal and boxes: the camera's reach
 
 
@@ -102,6 +103,17 @@ def check_reachable(course: Course, where: str, settings: NavigatorSettings) -> 
             f"{where}: field 'goal' = {list(course.goal)} is unreachable for a rider of radius "
             f"{settings.inscribed} m ({exc}); allowed: a goal the global planner reaches"
         ) from exc
+
+
+def _rest_index(log: dict[str, Array], arrived_at: float | None) -> int | None:
+    """The log row where the rider first came to rest (below ``REST_SPEED``) after the
+    planner's arrival, or None: the goal is judged there, not after the riders' standstill
+    creep (the MPC rider's 1-4 cm/s at a zero command)."""
+    if arrived_at is None or not log:
+        return None
+    after = (log["time"] >= arrived_at) & (np.abs(log["forward_velocity"]) < REST_SPEED)
+    found = np.nonzero(after)[0]
+    return int(found[0]) if len(found) else None
 
 
 def navigate(request: NavigateRequest) -> dict[str, Any]:
@@ -197,7 +209,8 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
     distance = np.linalg.norm(ridden - goal, axis=1) if len(ridden) else np.zeros(0)
     within = np.nonzero(distance <= course.goal_tolerance)[0]
     times = result.log.get("time", np.zeros(0))
-    reached = bool(len(distance) and distance[-1] <= course.goal_tolerance and not result.fell)
+    rest = _rest_index(result.log, navigator.arrived_at)
+    reached = rest is not None and distance[rest] <= course.goal_tolerance and not result.fell
     scores = score_cells(grid.frame, grid.occupied(), grid.observed, boxes, ridden)
     summary: dict[str, Any] = {
         "robot": request.robot,
@@ -213,6 +226,8 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
         "fall_reason": result.fall_reason,
         "reached": reached,
         "time_to_goal_s": float(times[within[0]]) if len(within) else None,
+        "rest_distance_to_goal_m": round(float(distance[rest]), 4) if rest is not None else None,
+        "rest_time_s": float(times[rest]) if rest is not None else None,
         "final_distance_to_goal_m": round(float(distance[-1]), 4) if len(distance) else None,
         "min_clearance_m": round(judge.min_clearance, 4)
         if np.isfinite(judge.min_clearance)
