@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from ridempc import options
+from ridempc.autonomy import cli as navigate_cli
 from ridempc.checks import writable_file
 from ridempc.errors import ConfigError, RidempcError, UnknownNameError
 from ridempc.interrupts import handled
@@ -163,6 +164,7 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--plot", type=options.path, default=None, help="write a PNG of the entry")
     sweep_cli.add_parser(commands)
     margin_cli.add_parser(commands)
+    navigate_cli.add_parser(commands)
     return parser
 
 
@@ -255,6 +257,7 @@ def _list() -> int:
     print("distributions (what a sweep draws; a .toml path too):")
     for name in distribution_names():
         print(f"  {name:<16} boards: {', '.join(distribution_boards(name))}")
+    navigate_cli.list_courses()
     return 0
 
 
@@ -319,6 +322,8 @@ def _unwritten(args: argparse.Namespace) -> str:
         return f"the entries under way were not stored in {folder} (the stored ones are complete)"
     if args.command == "margin":
         return margin_cli.unwritten(args)
+    if args.command == "navigate":
+        return navigate_cli.unwritten(args)
     if args.command == "library" and args.plot is not None:
         return f"no plot was written to {args.plot}"
     return "nothing was written"
@@ -339,6 +344,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         return sweep_cli.run(args)
     if args.command == "margin":
         return margin_cli.run(args)
+    if args.command == "navigate":
+        return navigate_cli.run(args)
     return _sim(args)
 
 

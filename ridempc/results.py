@@ -18,7 +18,14 @@ from ridempc.errors import ConfigError
 __all__ = ["COMPARISON_FILES", "RUN_FILES", "check_clearable", "clear_results"]
 
 # What ``ridempc sim`` writes (summary.json first: its absence marks an unfinished run).
-RUN_FILES: tuple[str, ...] = ("summary.json", "log.npz", "plots.png", "video.mp4", "snapshots.png")
+RUN_FILES: tuple[str, ...] = (
+    "summary.json",
+    "log.npz",
+    "plots.png",
+    "video.mp4",
+    "snapshots.png",
+    "map.png",  # ridempc navigate
+)
 # What ``ridempc compare`` writes beside its ``<controller>/seed-<k>/`` run folders.
 COMPARISON_FILES: tuple[str, ...] = ("comparison.json", "comparison.md", "overlay.png")
 

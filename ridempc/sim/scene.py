@@ -10,6 +10,7 @@ can change their friction.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -214,6 +215,7 @@ def build_scene(
     foot_offset: tuple[float, float] = (0.0, 0.0),
     platform_offsets: tuple[tuple[float, float], ...] = (),
     terrain: TerrainLayout | None = None,
+    edit_spec: Callable[[mujoco.MjSpec], None] | None = None,
 ) -> Scene:
     """Compile a rider on a board (or on flat ground) in a settled initial state.
 
@@ -226,6 +228,8 @@ def build_scene(
         platform_offsets: Per independent platform, a further shift of that platform, (x, y)
             [m] (Hovershoes started staggered).
         terrain: The scenario's terrain (:func:`ridempc.sim.terrain.lay_out`), or None.
+        edit_spec: Called with the model spec before it is compiled, to add to the scene
+            (a course's obstacles, a camera on the rider).
 
     The rider's feet go over the board's platform site(s): a rigid board puts the centroid
     of all feet over its one platform; independent platforms (Hovershoes) each move under
@@ -242,6 +246,8 @@ def build_scene(
         from ridempc.sim.terrain import add_terrain
 
         terrain_names = add_terrain(spec, terrain)
+    if edit_spec is not None:
+        edit_spec(spec)
     if robot is not None:
         add_imu_sensors(spec, robot.params.imu_site)
         rider_names = [robot.params.base_body]
