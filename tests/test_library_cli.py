@@ -56,7 +56,7 @@ def test_show_prints_the_table_and_plots(capsys, tmp_path: Path) -> None:
         "--board",
         "skateboard",
         "--entry",
-        "0.5",
+        "accelerate-0.50",  # (a target alone is ambiguous: repush-0.50 has it too)
         "--plot",
         str(plot),
     )
