@@ -454,8 +454,10 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     assert rider.summary()["safe_hold"] is None
     assert np.abs(result.log["forward_velocity"]).max() < 0.12  # [m/s]
     settled = result.log["time"] > 0.5
-    # No drift back: at the terminal factor of 10 the plans let her roll back at 0.05 m/s.
-    assert abs(result.log["forward_velocity"][settled].mean()) < 0.02  # [m/s]
+    # No drift back: at the terminal factor of 10 the plans let her roll back at 0.05 m/s;
+    # at 30 her mean speed is 0.020-0.024 m/s over the versions since (the ground-following
+    # frame moves it in the third digit): the bound tells the two apart.
+    assert abs(result.log["forward_velocity"][settled].mean()) < 0.03  # [m/s]
     for side in ("left", "right"):
         assert result.log[f"firmware_{side}_pitch"][settled].std() < 0.0045  # [rad]
 

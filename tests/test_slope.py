@@ -64,6 +64,7 @@ def test_the_mpc_frame_follows_the_ground_under_the_platforms() -> None:
     estimate = rider.estimator.state
     assert estimate is not None and estimate.boards
     n, state_map = rider.layout.names, rider.map
+    state_map.reset()  # the platforms' first height: where the estimate has them now
     later = replace(estimate, time=estimate.time + 1.0)  # ten filter time constants later
     level = state_map.follow_ground(later)
     before = state_map.state(estimate)
