@@ -8,8 +8,9 @@ of 100), and any variant is drawn again without the others.
 
 A variant is the base scenario with the draws added: pushes and kicks appended to its
 disturbances, a payload and the knobs appended to its changes, the start offsets added to
-its own, its sensor noise scaled. :func:`scenario_toml` writes it as a file that
-``ridempc sim --scenario`` reads back to an equal scenario.
+its own, its sensor noise scaled, a drawn slope or step added to its terrain.
+:func:`scenario_toml` writes it as a file that ``ridempc sim --scenario`` reads back to an
+equal scenario.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from ridempc.errors import ConfigError
 from ridempc.options import MAX_SEED
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sweep.distribution import Distribution, DrawnChange, Kick
+from ridempc.sweep.terrain_draws import CHOICES as TERRAIN_CHOICES
 from ridempc.sweep.tomltext import toml_text
 
 __all__ = ["Variant", "draw_variants", "scenario_toml", "variant_id"]
@@ -116,6 +118,9 @@ def draw_variants(
             where = f"distribution '{distribution.name}', variant {variant_id(index)}"
             raise ConfigError.from_validation(where, exc, Scenario) from exc
         drawn = {k: v for k, v in values.items() if laws[k].random}
+        if distribution.terrain is not None:  # what is ridden: 0 where nothing is laid
+            drawn = {k: v for k, v in drawn.items() if k not in TERRAIN_CHOICES}
+            drawn |= distribution.terrain.drawn(values)
         variants.append(Variant(variant_id(index), index, ride_seed, variant, drawn))
     return variants
 
@@ -215,6 +220,8 @@ def _variant_fields(
                 )
                 for p in range(platforms)
             )
+    if distribution.terrain is not None:
+        fields["terrain"] = [*fields["terrain"], *distribution.terrain.items(values)]
     if distribution.noise is not None:
         noise = dict(fields["noise"])
         for key in noise:
