@@ -29,6 +29,11 @@ equally likely). Example::
     slope_deg = {uniform = [-5.0, 5.0]}      # [deg] positive up
     step_height_radii = {uniform = [-0.6, -0.1]}   # [wheel radii] positive up
 
+    [steering]                               # a turn (ridempc.sweep.steering_draws)
+    yaw_rate = {uniform = [-0.3, 0.3]}       # [rad/s] positive to the left
+    t = {uniform = [3.0, 6.0]}               # [s]
+    duration = {uniform = [1.0, 3.0]}        # [s]
+
     [payload]                                # a point mass on a rider body
     body = "base"
     fraction = {uniform = [0.0, 0.1]}        # of the rider's mass [-]
@@ -52,7 +57,7 @@ Every number is checked finite and within physical bounds, every range non-empty
 drawn quantity has a dotted name (:meth:`Distribution.quantities`), e.g.
 ``push.magnitude``, ``kick.direction``, ``payload.offset.z``,
 ``start.platform_offsets.1.x``, ``noise.scale``, ``changes.board_mass.left_shoe.scale``,
-``terrain.slope_deg``;
+``terrain.slope_deg``, ``steering.yaw_rate``;
 an index follows ``push`` and ``kick`` where there are several (``push.0.t``).
 """
 
@@ -72,6 +77,7 @@ from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.scenarios.scenario import ParameterChange
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX
 from ridempc.sweep.laws import Law, Quantity, within
+from ridempc.sweep.steering_draws import SteeringDraws
 from ridempc.sweep.terrain_draws import TerrainDraws
 from ridempc.tomlfile import load_checked
 from ridempc.units import MAX_DURATION, CheckedModel
@@ -298,6 +304,8 @@ class Distribution(_Frozen):
         changes: Drawn knobs.
         terrain: A slope or a step ahead of the start
             (:class:`~ridempc.sweep.terrain_draws.TerrainDraws`), or None.
+        steering: A turn at a drawn yaw rate
+            (:class:`~ridempc.sweep.steering_draws.SteeringDraws`), or None.
     """
 
     name: str = Field(pattern=r"^[a-z0-9][a-z0-9._-]*$")
@@ -310,6 +318,7 @@ class Distribution(_Frozen):
     noise: NoiseScales | None = None
     changes: tuple[DrawnChange, ...] = ()
     terrain: TerrainDraws | None = None
+    steering: SteeringDraws | None = None
 
     @model_validator(mode="after")
     def _one_draw_per_knob(self) -> Distribution:
@@ -340,6 +349,8 @@ class Distribution(_Frozen):
             laws |= change.quantities()
         if self.terrain is not None:  # last: the other quantities draw as they did before it
             laws |= self.terrain.quantities()
+        if self.steering is not None:
+            laws |= self.steering.quantities()
         return laws
 
 
