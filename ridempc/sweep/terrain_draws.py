@@ -67,7 +67,7 @@ class TerrainDraws(CheckedModel):
     kinds: tuple[Literal["slope", "step"], ...] = Field(min_length=1)
     start: Start
     slope_deg: SlopeDeg | None = None
-    slope_length: SlopeLength = Law(fixed=3.0)
+    slope_length: SlopeLength = Law(fixed=3.0)  # the library's slopes run 3 m
     step_height: StepMetres | None = None
     step_height_radii: StepRadii | None = None
 
