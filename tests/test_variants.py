@@ -80,7 +80,7 @@ def test_a_variant_is_named_after_its_scenario_and_id() -> None:
 
 
 @pytest.mark.parametrize("board", BOARDS)
-@pytest.mark.parametrize("name", ["everyday", "hard"])
+@pytest.mark.parametrize("name", ["everyday", "hard", "everyday-terrain", "hard-terrain"])
 def test_every_drawn_quantity_lies_in_its_range(board: str, name: str) -> None:
     distribution = load_distribution(name, board)
     laws = distribution.quantities(platforms=2 if board == "hovershoes" else 0)
