@@ -53,7 +53,7 @@ def test_the_shipped_files_are_in_board_folders() -> None:
     assert distribution_files()
     for path in distribution_files():
         assert path.parent.name in BOARDS and path.parent.parent == DISTRIBUTIONS_DIR
-    assert set(distribution_names()) == {"everyday", "hard"}
+    assert set(distribution_names()) == {"everyday", "hard", "everyday-terrain", "hard-terrain"}
 
 
 def test_hard_is_wider_than_everyday() -> None:

@@ -19,6 +19,7 @@ from ridempc.robots import load_robot, robot_names
 from ridempc.run import RideRequest, check_request
 from ridempc.scenarios import load_scenario_file, resolve_scenario
 from ridempc.sweep.distribution import Distribution, Law, load_distribution
+from ridempc.sweep.terrain_draws import CHOICES as TERRAIN_CHOICES
 from ridempc.sweep.tomltext import toml_text
 from ridempc.sweep.variants import draw_variants, scenario_toml
 
@@ -79,17 +80,18 @@ def test_a_variant_is_named_after_its_scenario_and_id() -> None:
 
 
 @pytest.mark.parametrize("board", BOARDS)
-@pytest.mark.parametrize("name", ["everyday", "hard"])
+@pytest.mark.parametrize("name", ["everyday", "hard", "everyday-terrain", "hard-terrain"])
 def test_every_drawn_quantity_lies_in_its_range(board: str, name: str) -> None:
     distribution = load_distribution(name, board)
     laws = distribution.quantities(platforms=2 if board == "hovershoes" else 0)
     variants = _draw(board, name, 20)
-    random = {k for k, law in laws.items() if law.random}
+    random = {k for k, law in laws.items() if law.random} - set(TERRAIN_CHOICES)
     for variant in variants:
         assert set(variant.drawn) == random
         for key, value in variant.drawn.items():
             low, high = laws[key].bounds()
-            assert low <= value <= high, key
+            flat = key.startswith("terrain.") and value == 0.0  # level ground drawn
+            assert flat or low <= value <= high, key
 
 
 def test_the_draws_reach_the_scenario() -> None:

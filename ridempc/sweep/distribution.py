@@ -22,6 +22,18 @@ equally likely). Example::
     t = {uniform = [2.0, 8.0]}               # [s]
     duration = 0.1                           # [s]
 
+    [terrain]                                # a slope or a step ahead (ridempc.sweep.terrain_draws)
+    probability = 0.8
+    kinds = ["slope", "step"]
+    start = {uniform = [1.0, 2.0]}           # [m] along x
+    slope_deg = {uniform = [-5.0, 5.0]}      # [deg] positive up
+    step_height_radii = {uniform = [-0.6, -0.1]}   # [wheel radii] positive up
+
+    [steering]                               # a turn (ridempc.sweep.steering_draws)
+    yaw_rate = {uniform = [-0.3, 0.3]}       # [rad/s] positive to the left
+    t = {uniform = [3.0, 6.0]}               # [s]
+    duration = {uniform = [1.0, 3.0]}        # [s]
+
     [payload]                                # a point mass on a rider body
     body = "base"
     fraction = {uniform = [0.0, 0.1]}        # of the rider's mass [-]
@@ -44,19 +56,17 @@ Every number is checked finite and within physical bounds, every range non-empty
 ``[[changes]]`` entry is checked by the knob's own rules at both ends of its range. Each
 drawn quantity has a dotted name (:meth:`Distribution.quantities`), e.g.
 ``push.magnitude``, ``kick.direction``, ``payload.offset.z``,
-``start.platform_offsets.1.x``, ``noise.scale``, ``changes.board_mass.left_shoe.scale``;
+``start.platform_offsets.1.x``, ``noise.scale``, ``changes.board_mass.left_shoe.scale``,
+``terrain.slope_deg``, ``steering.yaw_rate``;
 an index follows ``push`` and ``kick`` where there are several (``push.0.t``).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
-import numpy as np
 from pydantic import (
-    AfterValidator,
-    BeforeValidator,
     Field,
     ValidationError,
     field_validator,
@@ -66,8 +76,11 @@ from pydantic import (
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.scenarios.scenario import ParameterChange
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX
+from ridempc.sweep.laws import Law, Quantity, within
+from ridempc.sweep.steering_draws import SteeringDraws
+from ridempc.sweep.terrain_draws import TerrainDraws
 from ridempc.tomlfile import load_checked
-from ridempc.units import MAX_DURATION, CheckedModel, Real
+from ridempc.units import MAX_DURATION, CheckedModel
 
 __all__ = [
     "DISTRIBUTIONS_DIR",
@@ -87,116 +100,21 @@ __all__ = [
 
 DISTRIBUTIONS_DIR = Path(__file__).resolve().parents[1] / "scenarios" / "distributions"
 
-_LAWS = ("fixed", "uniform", "normal", "choice")
-
-
-class Law(CheckedModel):
-    """How one quantity is drawn: exactly one of the fields below (a bare number in a file
-    is ``fixed``).
-
-    Attributes:
-        fixed: The value itself.
-        uniform: ``[low, high]``, drawn uniformly, ``low < high``.
-        normal: ``[mean, std]``, ``std > 0``, clipped to ``clip``.
-        clip: ``[low, high]`` for ``normal`` (required: a physical quantity is bounded).
-        choice: Values, one drawn with equal probability.
-    """
-
-    fixed: Real | None = None
-    uniform: tuple[Real, Real] | None = None
-    normal: tuple[Real, Real] | None = None
-    clip: tuple[Real, Real] | None = None
-    choice: tuple[Real, ...] | None = Field(None, min_length=1)
-
-    @model_validator(mode="after")
-    def _one_law(self) -> Law:
-        given = [law for law in _LAWS if getattr(self, law) is not None]
-        if len(given) != 1:
-            raise ValueError(
-                "allowed: a number, or exactly one of uniform = [low, high], "
-                "normal = [mean, std] with clip = [low, high], choice = [a, b, ...]"
-                + (f"; got {' and '.join(given)}" if given else "")
-            )
-        if self.uniform is not None and not self.uniform[0] < self.uniform[1]:
-            raise ValueError(
-                f"uniform = [{self.uniform[0]:g}, {self.uniform[1]:g}] is empty or inverted; "
-                "allowed: [low, high] with low < high"
-            )
-        if (self.clip is not None) != (self.normal is not None):
-            raise ValueError("clip = [low, high] goes with normal, and normal needs it")
-        if self.normal is not None and self.clip is not None:
-            mean, std = self.normal
-            low, high = self.clip
-            if not std > 0.0:
-                raise ValueError(f"normal std = {std:g}; allowed: above 0")
-            if not low < high or not low <= mean <= high:
-                raise ValueError(
-                    f"clip = [{low:g}, {high:g}] with mean {mean:g}; allowed: low < high "
-                    "and the mean between them"
-                )
-        return self
-
-    @property
-    def random(self) -> bool:
-        """Whether it varies from variant to variant."""
-        return self.fixed is None and not (self.choice is not None and len(set(self.choice)) < 2)
-
-    def bounds(self) -> tuple[float, float]:
-        """The lowest and highest value it can draw."""
-        if self.fixed is not None:
-            return self.fixed, self.fixed
-        if self.uniform is not None:
-            return self.uniform
-        if self.clip is not None:
-            return self.clip
-        assert self.choice is not None
-        return min(self.choice), max(self.choice)
-
-    def draw(self, rng: np.random.Generator) -> float:
-        """One value (a fixed one takes nothing from ``rng``)."""
-        if self.fixed is not None:
-            return float(self.fixed)
-        if self.uniform is not None:
-            return float(rng.uniform(*self.uniform))
-        if self.normal is not None and self.clip is not None:
-            return float(np.clip(rng.normal(*self.normal), *self.clip))
-        assert self.choice is not None
-        return float(self.choice[int(rng.integers(len(self.choice)))])
-
-
-def _number_is_fixed(value: Any) -> Any:
-    return value if isinstance(value, dict) else {"fixed": value}
-
-
-def _within(low: float, high: float, unit: str, low_open: bool = False) -> AfterValidator:
-    """A law whose every draw lies in ``[low, high]`` (``(low, high]`` with ``low_open``)."""
-
-    def check(law: Law) -> Law:
-        lo, hi = law.bounds()
-        if not ((lo > low if low_open else lo >= low) and hi <= high):
-            allowed = f"{'(' if low_open else '['}{low:g}, {high:g}]{unit and ' ' + unit}"
-            raise ValueError(f"draws in [{lo:g}, {hi:g}]; allowed: within {allowed}")
-        return law
-
-    return AfterValidator(check)
-
-
-Quantity = Annotated[Law, BeforeValidator(_number_is_fixed)]
 # A push of 100 N/kg (ten g) throws any of the robots: the scenario's bound on a push.
-PushMagnitude = Annotated[Quantity, _within(0.0, 100.0, "N/kg")]
+PushMagnitude = Annotated[Quantity, within(0.0, 100.0, "N/kg")]
 # A kick of 10 kN throws any board: the scenario's bound on a force.
-KickMagnitude = Annotated[Quantity, _within(0.0, 10_000.0, "N")]
-Direction = Annotated[Quantity, _within(-360.0, 360.0, "deg")]
-EventTime = Annotated[Quantity, _within(0.0, MAX_DURATION, "s")]
+KickMagnitude = Annotated[Quantity, within(0.0, 10_000.0, "N")]
+Direction = Annotated[Quantity, within(-360.0, 360.0, "deg")]
+EventTime = Annotated[Quantity, within(0.0, MAX_DURATION, "s")]
 # A push longer than 5 s is a load, not a push: the scenario's bound.
-PushDuration = Annotated[Quantity, _within(0.0, 5.0, "s", low_open=True)]
+PushDuration = Annotated[Quantity, within(0.0, 5.0, "s", low_open=True)]
 # At most the rider's own mass again: more is a second rider, not a payload.
-MassFraction = Annotated[Quantity, _within(0.0, 1.0, "")]
-PayloadOffset = Annotated[Quantity, _within(-PAYLOAD_OFFSET_MAX, PAYLOAD_OFFSET_MAX, "m")]
+MassFraction = Annotated[Quantity, within(0.0, 1.0, "")]
+PayloadOffset = Annotated[Quantity, within(-PAYLOAD_OFFSET_MAX, PAYLOAD_OFFSET_MAX, "m")]
 # A foot or platform moved by more than half a metre is off any deck: the scenario's bound.
-StartOffset = Annotated[Quantity, _within(-0.5, 0.5, "m")]
+StartOffset = Annotated[Quantity, within(-0.5, 0.5, "m")]
 # Ten times a sensor's noise or delay is a broken sensor, not a robustness study.
-NoiseScale = Annotated[Quantity, _within(0.0, 10.0, "", low_open=True)]
+NoiseScale = Annotated[Quantity, within(0.0, 10.0, "", low_open=True)]
 
 
 class _Frozen(CheckedModel):
@@ -384,6 +302,10 @@ class Distribution(_Frozen):
         start: Start offsets, or None.
         noise: Sensor noise and VIO latency scales, or None.
         changes: Drawn knobs.
+        terrain: A slope or a step ahead of the start
+            (:class:`~ridempc.sweep.terrain_draws.TerrainDraws`), or None.
+        steering: A turn at a drawn yaw rate
+            (:class:`~ridempc.sweep.steering_draws.SteeringDraws`), or None.
     """
 
     name: str = Field(pattern=r"^[a-z0-9][a-z0-9._-]*$")
@@ -395,6 +317,8 @@ class Distribution(_Frozen):
     start: StartOffsets | None = None
     noise: NoiseScales | None = None
     changes: tuple[DrawnChange, ...] = ()
+    terrain: TerrainDraws | None = None
+    steering: SteeringDraws | None = None
 
     @model_validator(mode="after")
     def _one_draw_per_knob(self) -> Distribution:
@@ -423,6 +347,10 @@ class Distribution(_Frozen):
             laws |= self.noise.quantities()
         for change in self.changes:
             laws |= change.quantities()
+        if self.terrain is not None:  # last: the other quantities draw as they did before it
+            laws |= self.terrain.quantities()
+        if self.steering is not None:
+            laws |= self.steering.quantities()
         return laws
 
 
@@ -476,6 +404,11 @@ def load_distribution(name_or_path: str, board: str) -> Distribution:
             f"{path}: field 'board': is '{distribution.board}'; allowed: '{board}' (the ride's "
             "board), or no board for a distribution that fits any"
         )
+    terrain = distribution.terrain
+    radius = getattr(loaded.params, "wheel_radius", None) if loaded is not None else None
+    why = terrain.step_error(radius, board) if terrain is not None else None
+    if why is not None:
+        raise ConfigError(f"{path}: {why}")
     start = distribution.start
     platforms = len(loaded.params.platform_sites) if loaded is not None else 0
     if start is not None and start.platform_offsets is not None and platforms < 2:

@@ -8,8 +8,10 @@ of 100), and any variant is drawn again without the others.
 
 A variant is the base scenario with the draws added: pushes and kicks appended to its
 disturbances, a payload and the knobs appended to its changes, the start offsets added to
-its own, its sensor noise scaled. :func:`scenario_toml` writes it as a file that
-``ridempc sim --scenario`` reads back to an equal scenario.
+its own, its sensor noise scaled, a drawn slope or step added to its terrain, a drawn turn
+added to its commands.
+:func:`scenario_toml` writes it as a file that ``ridempc sim --scenario`` reads back to an
+equal scenario.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ from ridempc.errors import ConfigError
 from ridempc.options import MAX_SEED
 from ridempc.scenarios.scenario import Scenario
 from ridempc.sweep.distribution import Distribution, DrawnChange, Kick
+from ridempc.sweep.steering_draws import own_yaw_commands, turn_events
+from ridempc.sweep.terrain_draws import CHOICES as TERRAIN_CHOICES
 from ridempc.sweep.tomltext import toml_text
 
 __all__ = ["Variant", "draw_variants", "scenario_toml", "variant_id"]
@@ -95,9 +99,13 @@ def draw_variants(
             f"distribution '{distribution.name}' is for board '{distribution.board}'; "
             f"allowed: one for board '{board}' or for any board"
         )
+    from ridempc.boards import load_board
+    from ridempc.boards.steering import check_steering
+
     rider_mass, platforms = _rider_and_platforms(robot, board)
     _check_times(scenario, distribution)
     laws = distribution.quantities(platforms)
+    steered = load_board(board) if distribution.steering is not None else None
     variants = []
     for index in range(samples):
         rng = np.random.default_rng([seed, index])
@@ -115,7 +123,12 @@ def draw_variants(
         except ValidationError as exc:
             where = f"distribution '{distribution.name}', variant {variant_id(index)}"
             raise ConfigError.from_validation(where, exc, Scenario) from exc
+        if distribution.steering is not None:  # a turn the board cannot make (the skateboard's)
+            check_steering(variant, steered)
         drawn = {k: v for k, v in values.items() if laws[k].random}
+        if distribution.terrain is not None:  # what is ridden: 0 where nothing is laid
+            drawn = {k: v for k, v in drawn.items() if k not in TERRAIN_CHOICES}
+            drawn |= distribution.terrain.drawn(values)
         variants.append(Variant(variant_id(index), index, ride_seed, variant, drawn))
     return variants
 
@@ -154,6 +167,21 @@ def _check_times(scenario: Scenario, distribution: Distribution) -> None:
                 f"distribution '{distribution.name}': field '{where}': draws up to "
                 f"{latest:g} s; allowed: within scenario '{scenario.name}' "
                 f"({scenario.duration:g} s)"
+            )
+    if distribution.steering is not None:
+        own = own_yaw_commands(scenario)
+        if own is not None:
+            raise ConfigError(
+                f"distribution '{distribution.name}': field 'steering': scenario "
+                f"'{scenario.name}' commands its own yaw rate ({own}); allowed: a base "
+                "scenario without yaw-rate commands, waves or a path"
+            )
+        end = distribution.steering.latest_end()
+        if end > scenario.duration:
+            raise ConfigError(
+                f"distribution '{distribution.name}': field 'steering': the turn ends up to "
+                f"{end:g} s (t + duration + ramp); allowed: within scenario "
+                f"'{scenario.name}' ({scenario.duration:g} s)"
             )
 
 
@@ -215,6 +243,10 @@ def _variant_fields(
                 )
                 for p in range(platforms)
             )
+    if distribution.steering is not None:
+        fields["commands"] = turn_events(distribution.steering, fields["commands"], values)
+    if distribution.terrain is not None:
+        fields["terrain"] = [*fields["terrain"], *distribution.terrain.items(values)]
     if distribution.noise is not None:
         noise = dict(fields["noise"])
         for key in noise:
