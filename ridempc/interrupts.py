@@ -307,7 +307,6 @@ def handled(
         if not ending:  # (else the solvers may still have words to say)
             sys.stdout, sys.stderr = streams
             _active = outer
-            handling.restore()  # Python's C-level SIGINT handler, whatever a solver left
         for s, handler in previous.items():  # after an interrupt the process is ending,
             if s != _WAKE and (ending or process_ends):  # by DEADLINE_S
                 handler = signal.SIG_IGN

@@ -35,10 +35,10 @@ from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatorParameters, StateEstimator, estimate_board, lapack
 from ridempc.estimation.imu import GRAVITY, ImuMount
 from ridempc.estimation.leg_odometry import LegOdometryModel
-from ridempc.estimation.rotations import matrix_to_quaternion, quaternion_to_matrix
 from ridempc.estimation.state import JointValues
 from ridempc.robots import load_robot
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
+from ridempc.rotations import matrix_to_quaternion, quaternion_to_matrix
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ridempc.estimation.rotations import matrix_to_quaternion
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.state_map import PlanarFrame
+from ridempc.rotations import matrix_to_quaternion
 from ridempc.trajopt.rotations import euler_zyx_matrix
 
 NAMES = ("com_x", "com_y", "com_z", "base_roll", "base_pitch", "base_yaw")

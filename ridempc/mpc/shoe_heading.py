@@ -43,8 +43,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ridempc.estimation.rotations import wrap_angle
 from ridempc.estimation.state import BoardEstimate, EstimatedState
+from ridempc.rotations import wrap_angle
 
 __all__ = ["MIN_SPEED", "TIME_CONSTANT", "ShoeHeading"]
 

@@ -40,9 +40,9 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState
-from ridempc.estimation.rotations import rpy_of_matrix, wrap_angle
 from ridempc.estimation.state import BoardEstimate
 from ridempc.robots.pinocchio_model import PinocchioRobot
+from ridempc.rotations import rpy_of_matrix, wrap_angle
 
 __all__ = [
     "ALONG_SLACK",
