@@ -46,7 +46,7 @@ from ridempc.sim.simulation import Simulation
 from tests.helpers import LimpController, RecordingController, scenario
 
 # horizontal sway force on the base [N/kg]: as strong as each robot's stand PD survives
-SWAY = {"cassie": 0.5, "cyberdog2": 2.0}
+SWAY = {"biped": 0.5, "quadruped": 2.0}  # [N/kg] by robot kind
 
 
 def _sway(robot, amplitude: float):
@@ -78,7 +78,7 @@ def _swaying_packets(robot, latency: float):
         controller,
         scenario(2.5, noise={"vio_latency": latency}),
         ground_truth=True,
-        external=_sway(robot, SWAY[robot.name]),
+        external=_sway(robot, SWAY[robot.params.kind]),
     )
     assert sim.run().status == "ok"
     return controller.packets

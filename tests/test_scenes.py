@@ -17,8 +17,13 @@ from tests.helpers import scenario
 
 BOARDS = [b for b in board_names() if b != "none"]
 PAIRS = [(r, b) for r in robot_names() for b in BOARDS]
-# The quadruped's four feet fit neither on two foot-sized shoes nor between a Segway's wheels.
-MISFITS = {("cyberdog2", "hovershoes"), ("cyberdog2", "segway")}
+# A quadruped's four feet fit neither on two foot-sized shoes nor between a Segway's wheels.
+MISFITS = {
+    (r, b)
+    for r in robot_names()
+    if load_robot(r).params.kind == "quadruped"
+    for b in ("hovershoes", "segway")
+}
 MISSION = {"hovershoes": "cassie", "segway": "cassie", "skateboard": "cyberdog2"}
 SINK = 0.003  # [m] deepest a standing foot may press into a board
 

@@ -62,9 +62,9 @@ N_CONFIGURATIONS = 4
 # What holds each robot up in closed loop: Cassie's leaf springs are taken as rigid, because
 # MuJoCo's soft achilles-rod connect stretches under load and the rigidly closed heel-spring
 # estimate is then twice the true deflection (see ridempc.wbc.constraints.RigidSpringConstraint).
-CLOSED_LOOP_SETTINGS = {  # on OSQP: its statuses and its workspace are what they check
-    "cyberdog2": WbcSettings(solver="osqp"),
-    "cassie": WbcSettings(springs="rigid", solver="osqp"),
+CLOSED_LOOP_SETTINGS = {  # by robot kind; on OSQP: its statuses and its workspace are checked
+    "quadruped": WbcSettings(solver="osqp"),
+    "biped": WbcSettings(springs="rigid", solver="osqp"),
 }
 
 
@@ -644,7 +644,7 @@ def test_wbc_holds_the_robot_through_pushes(robot) -> None:
             Disturbance(t=2.0, force=(0.0, 0.8, 0.0), per_kg=True, duration=0.2),
         ),
     )
-    controller = WbcStand(robot, CLOSED_LOOP_SETTINGS[robot.name])
+    controller = WbcStand(robot, CLOSED_LOOP_SETTINGS[robot.params.kind])
     result = Simulation(build_scene(robot, DEFAULT_PHYSICS_HZ), controller, scenario).run()
     assert result.status == "ok", result.fall_reason or result.error
     position = result.log["base_position"]
@@ -679,7 +679,7 @@ def test_the_wbc_alone_stands_on_the_hovershoes_knowing_they_roll() -> None:
     scenario = Scenario(name="wbc-hovershoes", duration=1.5)
     ends = {}
     for rolling in (True, False):
-        controller = WbcStand(robot, CLOSED_LOOP_SETTINGS["cassie"], board, rolling)
+        controller = WbcStand(robot, CLOSED_LOOP_SETTINGS["biped"], board, rolling)
         scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board)
         try:
             result = Simulation(scene, controller, scenario).run()
