@@ -91,7 +91,6 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.deck_support import steering_bounds
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.input_rate import hold_first_input
@@ -520,9 +519,9 @@ class MpcRider(Controller):
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
-        if balancing or self.manoeuvre.kind == REPUSH:  # within what its support holds
-            steering = self._steering_roll(command, now, speed)
-            roll = roll + self._supported(steering, t_ref, estimate)
+        pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
+        if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
+            roll = roll + self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
@@ -809,29 +808,6 @@ class MpcRider(Controller):
         if rates is None:
             rates = np.full(len(times), float(command.yaw_rate))
         return np.array([self.roll_steering.roll(float(w), speed) for w in rates])
-
-    def _supported(self, rolls: Array, t_ref: float, estimate: EstimatedState) -> Array:
-        """The steering ``rolls`` at the horizon's nodes [rad] within what the reference's
-        support holds at reference time ``t_ref`` [s] and after
-        (:func:`~ridempc.mpc.deck_support.steering_bounds`: none with a foot on the ground,
-        only away from a swinging foot), at each node and where its roll is read
-        (``roll_lead`` ahead)."""
-        settings = self.mpc.settings
-        sides = self._contact_sides(estimate)
-        nodes = t_ref + settings.dt * np.arange(len(rolls))
-        for times in (nodes, nodes + self.pair.roll_lead):
-            low, high = steering_bounds(self.mpc.reference, times, sides)
-            rolls = np.clip(rolls, low, high)
-        return rolls
-
-    def _contact_sides(self, estimate: EstimatedState) -> Array:
-        """Each contact's side of the deck, +1 left of its centre line and -1 right, from
-        the feet's estimated places across the deck's heading."""
-        feet = np.asarray(estimate.foot_position, dtype=float)
-        board = estimate.board
-        yaw = float(board.yaw) if board is not None else 0.0
-        across = _to_deck(yaw, feet[:, :2] - feet[:, :2].mean(axis=0))[:, 1]
-        return np.asarray(np.sign(across[list(self._contact_foot)]), dtype=float)
 
     def _roll_turn(self, roll: Array, speed: float) -> Array:
         """The turn a commanded deck roll steers, over the horizon's steps [rad/s]: on the
