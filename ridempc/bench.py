@@ -1,6 +1,6 @@
 """``ridempc bench``: MPC and WBC solve times on recorded problems, and other QP solvers.
 
-For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIRS`):
+For each robot-board pair with a pair file (:func:`ridempc.mpc.pairs.mpc_pair_names`):
 
 1. **Record.** The ``mpc`` rider rides the pair's benchmark scenario
    (:data:`BENCH_SCENARIOS`: a manoeuvre, not standing still, where the QPs are hardest;
@@ -764,16 +764,16 @@ def bench(
     from dataclasses import asdict
 
     from ridempc.errors import UnknownNameError
-    from ridempc.mpc.pairs import MPC_PAIRS
+    from ridempc.mpc.pairs import mpc_pair_names
 
     kind = QP_KINDS["wbc"]
     wbc_solver = kind.solver if wbc_solver is None else wbc_solver
     if wbc_solver not in kind.solvers:
         raise UnknownNameError("whole-body QP solver", wbc_solver, kind.solvers)
-    names = list(pairs) if pairs else list(MPC_PAIRS)
+    names = list(pairs) if pairs else list(mpc_pair_names())
     for name in names:
-        if name not in MPC_PAIRS:
-            raise UnknownNameError("robot-board pair for the MPC", name, MPC_PAIRS)
+        if name not in mpc_pair_names():
+            raise UnknownNameError("robot-board pair for the MPC", name, mpc_pair_names())
     from ridempc.scenarios import resolve_scenario
 
     recorded = {n: _scenario_of(n, scenario) for n in names}

@@ -41,7 +41,7 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.input_rate`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
-   the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
+   the Z-Y-X angles, where the pair asks for it (``wbc.feedforward``) the plan's
    first-step accelerations :math:`(v_1 - v_0)/\\Delta t` and
    :math:`(\\omega_1 - \\omega_0)/\\Delta t` fed forward, the first input's contact forces
    (summed per foot; on the Hovershoes low-passed from solve to solve,
@@ -58,7 +58,7 @@ Every 2 ms (500 Hz) the rider
    if it touches something;
 4. sends the QP's torques as feedforward, each led over its motor's torque delay
    (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD, at the
-   robot's ``tracking_gain_scale`` of its default stiffnesses; a delayed motor's damping is
+   pair's ``tracking_gain_scale`` of its default stiffnesses; a delayed motor's damping is
    the one of largest phase margin for that stiffness at the joint's inertia in the riding
    posture (:func:`~ridempc.robots.delay_margin.tracking_damping`), the others' the same
    scale of their default damping.
@@ -77,14 +77,13 @@ import time
 from concurrent.futures import Future
 from dataclasses import replace
 from functools import cache
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
-from ridempc.boards.skateboard.parameters import SkateboardParameters
 from ridempc.boards.skateboard.reduced import yaw_rate
 from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
@@ -140,11 +139,6 @@ __all__ = ["MpcRider", "platform_feet", "rolling_platforms"]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
-# Board inputs of the library that this rider does not realise, held at zero in the MPC: the
-# Segway's knee bar (the legs' push on the pad is not in the model; planning turns with a bar
-# nobody pushes let the yaw run off: stand-still fell at 1.5 s, pinned it stands). The rider
-# leans into the bar instead (ridempc.mpc.lean).
-UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
 WBC_GRACE_TICKS: int = 5
@@ -186,13 +180,13 @@ def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
     its translating mass with no drive (3.2 kg under a 9 kg dog: taken for ground, the deck
     feet pushed it 0.24 m/s past its plan as the pusher returned, and push-off-0.7 fell at
     2.55 s instead of 3.41 s); none otherwise."""
-    if board is not None and isinstance(board.params, SkateboardParameters):
+    features = board.kind.features if board is not None else frozenset()
+    if board is not None and "deck_roll" in features:
         return (RollingPlatform(mass=skateboard_model(board).mass, drive=0.0),)
-    if board is None or not isinstance(board.params, HovershoesParameters):
+    if board is None or "shoes" not in features:
         return ()
-    shoes = wheeled_board(board)
-    assert isinstance(shoes, HovershoesBoard)
-    params = board.params
+    shoes = cast(HovershoesBoard, wheeled_board(board))
+    params = cast(HovershoesParameters, board.params)
     shoe = RollingPlatform(
         mass=shoes.shoe_mass,
         drive=shoes.reduced.c4,
@@ -237,6 +231,8 @@ class MpcRider(Controller):
         from ridempc.boards import load_board
 
         self.pair = load_mpc_pair(robot.name, board)
+        stages = self.pair.description.stages  # the pair file's per-pair mechanisms
+        tuning = self.pair.description.wbc
         # Ticks from the state a solve starts from to the tick its plan takes over: with 1
         # or more OSQP iterates in a thread beside the loop and the ticks between follow
         # the previous plan; waited for at that tick, so that a ride does not depend on the
@@ -260,7 +256,10 @@ class MpcRider(Controller):
             robot.name, board, first.library_kind, first.target, settings
         )
         names = self.mpc.reference.input_names
-        pinned = {n: 0.0 for n in UNREALISED_INPUTS if n in names}
+        # Board inputs of the library that this rider does not realise (the pair file's
+        # ``unrealised_inputs``), held at zero in the MPC.
+        unrealised = self.pair.description.mpc.unrealised_inputs
+        pinned = {n: 0.0 for n in unrealised if n in names}
         self.mpc.fix_inputs({**pinned, **self.mpc.settings.fixed_inputs})
         # Yaw-rate commands are laid over the reference only where the rider can turn the
         # board (not the Segway with its knee bar pinned: it rode yaw-steps straight, and
@@ -273,7 +272,7 @@ class MpcRider(Controller):
         # A board turned by a bar the legs push (the Segway's knee bar, held at zero in the
         # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
         self.crouch = Crouch.of(robot, board)
-        self.lean = LeanSteering() if "knee_bar" in pinned and not self.steers else None
+        self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_names(reference.state_names)
@@ -281,19 +280,13 @@ class MpcRider(Controller):
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
         # achilles-rod constraint) drives the QP off (see the WBC's tests).
-        # The MPC's forces weigh ``wbc_force_weight`` (100 by default, 100x the WBC's own
-        # default): their distribution over the feet is what rolls a deck or a platform, and
-        # the CoM and orientation tasks leave it free (the dog's roll-tracking: roll RMSE
-        # 0.063 rad at 1, 0.048 at 100). The dog's is 800: at 100 its WBC unloaded the
-        # three-leg stance's light foot that the MPC keeps at 0.4 of its share, and the
-        # foot lifted off the deck (push-offs, seeds 0 and 1: 2 of 8 stayed up at 100, 4 at
-        # 300, 6 at 600 and 800, 5 at 1000, none at 10000, all with coasting; 7 at 800 with
-        # the roll's turn too; roll-tracking's RMSE 0.0150 rad at 100, 0.0149 at 300, 0.0181
-        # at 600, 0.0196 at 800, 0.0207 at 1000).
+        # The MPC's forces weigh the pair file's ``wbc.force_weight`` (the WBC's own default
+        # is 1): their distribution over the feet is what rolls a deck or a platform, and the
+        # CoM and orientation tasks leave it free (measurements: docs/tuning.md, "Pair files").
         sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
         settings_wbc = WbcSettings(
             springs="rigid" if sprung else "passive",
-            force_weight=robot.params.wbc_force_weight,
+            force_weight=tuning.force_weight,
             pyramid=self.pair.pyramid,
             solver=wbc_solver or solver_for("wbc"),
         )
@@ -304,10 +297,10 @@ class MpcRider(Controller):
             posture=motor_posture(self.pinocchio, robot, robot.ride_qpos(board)),
             platforms=rolling_platforms(loaded),
         )
-        self._feedforward = robot.params.wbc_feedforward
+        self._feedforward = tuning.feedforward
         tau = self.pair.force_time_constant  # the forces the WBC gets, low-passed
         self.force_filter = ForceFilter(tau) if tau is not None else None
-        scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
+        scale = tuning.tracking_gain_scale  # the QP's torques lead, the PD follows
         self.kp = scale * np.array([m.kp for m in robot.motors])
         self.kd = tracking_damping(  # each delayed loop damped at its largest margin
             robot.mj_model,
@@ -333,21 +326,24 @@ class MpcRider(Controller):
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
         self.shoes = self._shoe_observer(loaded)
         # each shoe's heading from its direction of travel: the soles creep round on the pads
-        self.shoe_heading = ShoeHeading(self.shoes.platforms) if self.shoes is not None else None
+        self.shoe_heading = (
+            ShoeHeading(self.shoes.platforms)
+            if self.shoes is not None and stages.shoe_heading is not None
+            else None
+        )
+        self._guidance = stages.guidance is not None  # shoe headings turned onto their lines
         n = self.layout.names  # each shoe's (x, y, heading, speed) indices in the MPC's state
         self._shoe_columns = (
             tuple((n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes)
             if self.shoes is not None
             else ()
         )
-        deck = (
-            skateboard_model(loaded).reduced
-            if loaded is not None and isinstance(loaded.params, SkateboardParameters)
-            else None
-        )
-        self._steer_gain = deck.steer_gain if deck is not None else None
+        rolls = stages.roll_steering is not None or stages.roll_observer is not None
+        deck = skateboard_model(loaded).reduced if loaded is not None and rolls else None
+        steers = deck if stages.roll_steering is not None else None
+        self._steer_gain = steers.steer_gain if steers is not None else None
         # a yaw-rate command steered by the deck's roll, eq. (14) inverted
-        self.roll_steering = RollSteering(gain=deck.steer_gain) if deck is not None else None
+        self.roll_steering = RollSteering(gain=steers.steer_gain) if steers is not None else None
         self._blend: SwitchBlend | None = None  # a re-push's reference blended in
         index, gain = self.layout.names, self.pair.roll_observer
         self.roll_observer = (
@@ -389,12 +385,11 @@ class MpcRider(Controller):
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
-        """On Hovershoes, the observer of where each foot stands along its shoe and of each
-        shoe's drag."""
-        if board is None or not isinstance(board.params, HovershoesParameters):
+        """With the ``shoe_observer`` stage (Hovershoes), the observer of where each foot
+        stands along its shoe and of each shoe's drag."""
+        if board is None or self.pair.description.stages.shoe_observer is None:
             return None
-        shoes = wheeled_board(board)
-        assert isinstance(shoes, HovershoesBoard)
+        shoes = cast(HovershoesBoard, wheeled_board(board))
         names = self.wbc.model.foot_names
         platform_of = {foot: k for k, group in enumerate(self.platform_feet) for foot in group}
         sites = [platform_of.get(names[f], -1) for f in self.wbc.model.site_foot]
@@ -563,7 +558,9 @@ class MpcRider(Controller):
             self._diagnostics["lean_offset"] = self.lean.offset
         if self.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
-            states = steer_onto_lines(problem.state_reference, problem.initial_state, columns)
+            states = problem.state_reference
+            if self._guidance:
+                states = steer_onto_lines(states, problem.initial_state, columns)
             states = self.shoes.shift_reference(states, columns)
             c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)

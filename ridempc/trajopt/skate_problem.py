@@ -90,7 +90,7 @@ class SkateOptions:
     Attributes:
         dt: Grid step [s].
         friction: Foot friction coefficient :math:`\\mu` [-].
-        pusher: Contact site of the pushing foot.
+        pusher: Contact site of the pushing foot (the pair file's ``trajopt.options``).
         period: Push period [s] (1.2 s in the paper).
         sweep: Distance the pushing foot sweeps along the ground per push [m].
         speed_per_stride: Speed gained per push, which sets the number of strides [m/s].
@@ -153,7 +153,7 @@ class SkateOptions:
 
     dt: float = 0.05
     friction: float = 0.6
-    pusher: str = "RL_contact"
+    pusher: str = ""
     period: float = 1.2
     sweep: float = 0.2
     speed_per_stride: float = 0.3
