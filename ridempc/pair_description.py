@@ -15,14 +15,22 @@ from __future__ import annotations
 
 from functools import cache
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, model_validator
+from pydantic import Field, model_validator
 
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.friction import SHAPES
 from ridempc.paths import pairs_dir
 from ridempc.tomlfile import read_toml, validate
+from ridempc.units import (
+    CheckedModel,
+    Flag,
+    NonNegative,
+    NonNegativeCount,
+    Positive,
+    Real,
+)
 
 __all__ = [
     "STAGE_NEEDS",
@@ -39,10 +47,16 @@ __all__ = [
 ]
 
 MPC_DIVIDER_TICKS: int = 15  # control ticks per MPC step: a plan is due within one step
+MAX_SPEED: float = 20.0  # [m/s] beyond any board's; a bound on target speeds
+MAX_OPTION: float = 1e6  # beyond any option's figure in its units (weights reach 1e2)
+
+Speed = Annotated[Positive, Field(le=MAX_SPEED, description="[m/s]")]
+OptionValue = Annotated[Real, Field(ge=-MAX_OPTION, le=MAX_OPTION)]
+Fraction = Annotated[Real, Field(ge=0.0, le=1.0)]
 
 
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+class _Frozen(CheckedModel):
+    """Frozen, unknown keys refused, numbers finite and given as numbers."""
 
 
 class TrajoptSection(_Frozen):
@@ -55,43 +69,54 @@ class TrajoptSection(_Frozen):
             "skateboard (:mod:`ridempc.trajopt.skate_problem`)."
         )
     )
-    default_targets: tuple[PositiveFloat, ...] = Field(
+    default_targets: tuple[Speed, ...] = Field(
         min_length=1, description="Target speeds of the committed library [m/s]."
     )
-    options: dict[str, float | int | str | bool] = Field(
+    options: dict[str, OptionValue] = Field(
         default_factory=dict,
-        description="The problem's option fields (RideOptions, SkateOptions) for this pair.",
+        description="The problem's numeric option fields (RideOptions, SkateOptions).",
     )
     hips: tuple[str, ...] = Field(
         default=(), description="``ride``: the simplified rider's hip-pitch joints."
     )
-    leg_range: tuple[PositiveFloat, PositiveFloat] = Field(
+    leg_range: tuple[Positive, Positive] = Field(
         default=(0.85, 1.03),
         description="``ride``: leg lengths allowed, as fractions of the riding stance's [-].",
     )
+    pusher: str | None = Field(
+        default=None, description="``skate``: the contact site of the pushing foot."
+    )
 
     @model_validator(mode="after")
-    def _hips_for_ride(self) -> TrajoptSection:
+    def _names_the_problem_needs(self) -> TrajoptSection:
         if self.problem == "ride" and not self.hips:
             raise ValueError("a 'ride' problem needs the rider's hips (hip-pitch joints)")
-        if self.leg_range[0] >= self.leg_range[1]:
-            raise ValueError(f"leg_range {self.leg_range}: the first must be below the second")
+        if self.problem == "skate" and self.pusher is None:
+            raise ValueError("a 'skate' problem needs the pushing foot's contact site, pusher")
+        if not self.leg_range[0] < self.leg_range[1] <= 2.0:
+            raise ValueError(
+                f"leg_range {self.leg_range}: the first below the second, both at most 2"
+            )
         return self
+
+    def problem_options(self) -> dict[str, float | str]:
+        """The problem's option defaults for this pair: its numbers and its pusher."""
+        named = {"pusher": self.pusher} if self.pusher is not None else {}
+        return {**self.options, **named}
 
 
 class MpcSection(_Frozen):
     """The MPC's settings for the pair (:class:`ridempc.mpc.pairs.MpcPair`)."""
 
     pyramid: str = Field(description=f"Friction pyramid shape, one of {', '.join(SHAPES)}.")
-    terminal_factor: PositiveFloat = Field(
+    terminal_factor: Positive = Field(
         le=1e4, description="Terminal weight over the stage weight, Q_N = this x Q [-]."
     )
-    start_speed: float = Field(
-        ge=0.0, le=1.0, description="An accelerate from rest starts at this speed [m/s]."
+    start_speed: NonNegative = Field(
+        le=1.0, description="An accelerate from rest starts at this speed [m/s]."
     )
-    speed_preview: bool = Field(description="Follow the speed planned a horizon ahead.")
-    plan_latency: int = Field(
-        ge=0,
+    speed_preview: Flag = Field(description="Follow the speed planned a horizon ahead.")
+    plan_latency: NonNegativeCount = Field(
         lt=MPC_DIVIDER_TICKS,
         description="Control ticks from a solve's state to the tick its plan takes over.",
     )
@@ -109,65 +134,63 @@ class MpcSection(_Frozen):
 class WbcSection(_Frozen):
     """The MPC rider's whole-body QP and motor PD settings for the pair."""
 
-    force_weight: PositiveFloat = Field(
+    force_weight: Positive = Field(
         le=1e6,  # beyond it the QP's other tasks vanish below OSQP's tolerances
         description="Weight of the MPC's contact forces in the QP [(kg/N)^2].",
     )
-    tracking_gain_scale: PositiveFloat = Field(
+    tracking_gain_scale: Positive = Field(
         le=1.0, description="Fraction of the motors' PD gains about the QP's targets [-]."
     )
-    feedforward: float = Field(
-        ge=0.0, le=1.0, description="Share of the plan's first-step accelerations fed forward."
+    feedforward: Fraction = Field(
+        description="Share of the plan's first-step accelerations fed forward [-]."
     )
 
 
-class Flag(_Frozen):
+class Used(_Frozen):
     """A stage without parameters: present means used."""
 
 
 class ForceFilterStage(_Frozen):
-    time_constant: PositiveFloat = Field(le=1.0, description="Low-pass on the forces [s].")
+    time_constant: Positive = Field(le=1.0, description="Low-pass on the forces [s].")
 
 
 class RollObserverStage(_Frozen):
-    gain: PositiveFloat = Field(le=1.0, description="beta of the torque estimate [-].")
+    gain: Positive = Field(le=1.0, description="beta of the torque estimate [-].")
 
 
 class StanceStage(_Frozen):
-    roll_offset: PositiveFloat = Field(
-        le=10.0, description="CoM offset per radian of deck roll [m/rad]."
-    )
+    roll_offset: Positive = Field(le=10.0, description="CoM offset per radian of roll [m/rad].")
 
 
 class RollLeadStage(_Frozen):
-    lead: float = Field(ge=0.0, le=1.0, description="Commanded roll read this far ahead [s].")
+    lead: NonNegative = Field(le=1.0, description="Commanded roll read this far ahead [s].")
 
 
 class SwingForceStage(_Frozen):
-    force_step: PositiveFloat = Field(description="Tolerance of a deck force's change [N].")
+    force_step: Positive = Field(le=1e4, description="Tolerance of a deck force's change [N].")
 
 
 class PushWeightsStage(_Frozen):
-    tolerances: dict[str, PositiveFloat] = Field(
+    tolerances: dict[str, Annotated[Positive, Field(le=100.0)]] = Field(
         min_length=1, description="Accepted deviation of states over a push-off, by name."
     )
-    max_target: PositiveFloat = Field(description="Largest push-off target they apply to.")
+    max_target: Speed = Field(description="Largest push-off target they apply to [m/s].")
 
 
 class SettleStage(_Frozen):
-    duration: PositiveFloat = Field(le=10.0, description="Settle over the feet in this [s].")
+    duration: Positive = Field(le=10.0, description="Settle over the feet in this [s].")
 
 
 class Stages(_Frozen):
     """The MPC rider's per-pair stages; a stage left out is not used."""
 
-    tipping: Flag | None = None
+    tipping: Used | None = None
     force_filter: ForceFilterStage | None = None
-    shoe_observer: Flag | None = None
-    shoe_heading: Flag | None = None
-    guidance: Flag | None = None
-    lean: Flag | None = None
-    roll_steering: Flag | None = None
+    shoe_observer: Used | None = None
+    shoe_heading: Used | None = None
+    guidance: Used | None = None
+    lean: Used | None = None
+    roll_steering: Used | None = None
     roll_observer: RollObserverStage | None = None
     stance: StanceStage | None = None
     roll_lead: RollLeadStage | None = None
@@ -217,6 +240,16 @@ class PairDescription(_Frozen):
         return f"{self.robot}-{self.board}"
 
     @model_validator(mode="after")
+    def _options_known(self) -> PairDescription:
+        allowed = problem_option_names(self.trajopt.problem)
+        for key in self.trajopt.options:
+            if key not in allowed:
+                raise ValueError(
+                    f"field 'trajopt.options.{key}': unknown key; allowed: {', '.join(allowed)}"
+                )
+        return self
+
+    @model_validator(mode="after")
     def _stages_have_their_stages(self) -> PairDescription:
         used = set(self.stages.used())
         for stage in self.stages.used():
@@ -224,6 +257,17 @@ class PairDescription(_Frozen):
             if missing:
                 raise ValueError(f"stage '{stage}' needs the stage '{missing[0]}'")
         return self
+
+
+def problem_option_names(problem: str) -> tuple[str, ...]:
+    """The numeric option fields of a trajectory problem (``RideOptions``, ``SkateOptions``)."""
+    import dataclasses
+
+    from ridempc.trajopt.ride_problem import RideOptions
+    from ridempc.trajopt.skate_problem import SkateOptions
+
+    options = {"ride": RideOptions, "skate": SkateOptions}[problem]
+    return tuple(f.name for f in dataclasses.fields(options) if f.type in ("float", float))
 
 
 def pair_description_names() -> tuple[str, ...]:
@@ -276,8 +320,8 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
     """Every stage of ``description`` fits its board, and its names exist in the robot.
 
     Raises:
-        ConfigError: A stage needs a board feature the board lacks, or a hip joint or an
-            option naming a site is not in the robot's description.
+        ConfigError: A stage needs a board feature the board lacks, or a hip joint or the
+            pusher is not in the robot's description.
     """
     from ridempc.boards import load_board
     from ridempc.robots import load_robot
@@ -292,7 +336,13 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
                 f"'{description.board}' has {', '.join(sorted(features)) or 'none'}"
             )
     robot = load_robot(description.robot)
-    joints = {m for m in robot.params.motors}
+    pusher, sites = description.trajopt.pusher, robot.params.contact_sites
+    if pusher is not None and pusher not in sites:
+        raise ConfigError(
+            f"{shown}: field 'trajopt.pusher': '{pusher}' is not a contact site of "
+            f"{description.robot}; allowed: {', '.join(sites)}"
+        )
+    joints = set(robot.params.motors)
     for hip in description.trajopt.hips:
         if hip not in joints:
             raise ConfigError(

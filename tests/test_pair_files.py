@@ -11,9 +11,11 @@ import pytest
 
 from ridempc import cli
 from ridempc.errors import ConfigError, UnknownNameError
-from ridempc.mpc.pairs import load_mpc_pair, mpc_pair_names
+from ridempc.mpc.pairs import check_library_names, load_mpc_pair, mpc_pair_names
+from ridempc.mpc.reference import select_reference
 from ridempc.pair_description import (
     STAGE_NEEDS,
+    PushWeightsStage,
     Stages,
     load_pair_description,
     pair_description_names,
@@ -59,6 +61,21 @@ def test_the_stages_become_the_mpc_pairs_settings() -> None:
     assert deck.roll_observer == pytest.approx(0.3) and deck.stance_roll == pytest.approx(0.42)
     assert deck.roll_lead == pytest.approx(0.08) and deck.settle is not None
     assert dict(deck.push_tolerances) == {"vx": 0.0125, "board_v": 0.05}
+
+
+def test_the_names_a_pair_file_gives_are_its_librarys() -> None:
+    """Push tolerances name states, unrealised inputs name inputs of the pair's library
+    (checked when the rider is built, before the ride)."""
+    description = load_pair_description("cyberdog2", "skateboard")
+    reference = select_reference("cyberdog2", "skateboard", "accelerate", 0.5)
+    check_library_names(description, reference)
+    mpc = description.mpc.model_copy(update={"unrealised_inputs": ("knee_bar",)})
+    with pytest.raises(ConfigError, match="field 'mpc.unrealised_inputs': 'knee_bar'"):
+        check_library_names(description.model_copy(update={"mpc": mpc}), reference)
+    push = PushWeightsStage(tolerances={"board_speed": 0.05}, max_target=0.7)
+    stages = description.stages.model_copy(update={"push_weights": push})
+    with pytest.raises(ConfigError, match="'stages.push_weights.tolerances.board_speed'"):
+        check_library_names(description.model_copy(update={"stages": stages}), reference)
 
 
 def test_an_undescribed_pair_is_an_unknown_name() -> None:
@@ -122,6 +139,14 @@ def _edited(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ),
         ("cassie-segway", 'board = "segway"', 'board = "hovershoes"', "field 'robot'"),
         ("cyberdog2-skateboard", "[mpc]", "[mpc]\nhorizon = 12", "field 'mpc.horizon'"),
+        (
+            "cyberdog2-skateboard",
+            'pusher = "RL_contact"',
+            'pusher = "RL_foot"',
+            "field 'trajopt.pusher': 'RL_foot' is not a contact site of cyberdog2",
+        ),
+        ("cyberdog2-skateboard", 'pusher = "RL_contact"', "", "needs the pushing foot's"),
+        ("cassie-segway", "force_weight = 1000.0", 'force_weight = "1000"', "force_weight"),
     ],
 )
 def test_a_bad_pair_file_names_the_file_and_the_field(

@@ -49,7 +49,7 @@ def test_problem_structure_and_bounds() -> None:
     x0, _ = initial_skate_state(robot, board)
     assert np.allclose(problem.lbw[:nx], x0) and np.allclose(problem.ubw[:nx], x0)
     # The pushing foot carries no force while it swings; joint speeds within 31 rad/s.
-    defaults = load_pair_description("cyberdog2", "skateboard").trajopt.options
+    defaults = load_pair_description("cyberdog2", "skateboard").trajopt.problem_options()
     masks = skate_schedule(robot, 0.3, skate_options({}, defaults)).contact_masks()
     stride = 2 * nx + nu
     upper = problem.ubw[: n * stride].reshape(n, stride)[:, nx : nx + nu] * problem.input_scale

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 
 from ridempc.boards import load_board
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
+from ridempc.errors import ConfigError
 from ridempc.mpc.buffered import BufferedFunction
 from ridempc.mpc.codegen import compiled
 from ridempc.mpc.reference import MotionReference
@@ -39,7 +40,13 @@ from ridempc.trajopt.rigid_body import GRAVITY
 from ridempc.trajopt.skate_pair import skate_models
 from ridempc.trajopt.skateboard import BOARD_STATE, deck_frame
 
-__all__ = ["MpcPair", "load_mpc_pair", "mpc_pair_names", "surface_rotations"]
+__all__ = [
+    "MpcPair",
+    "check_library_names",
+    "load_mpc_pair",
+    "mpc_pair_names",
+    "surface_rotations",
+]
 
 Array = NDArray[np.float64]
 
@@ -249,3 +256,26 @@ def load_mpc_pair(robot: str, board: str) -> MpcPair:
     """
     description = load_pair_description(robot, board)
     return _BUILDERS[description.trajopt.problem](description)
+
+
+def check_library_names(description: PairDescription, reference: MotionReference) -> None:
+    """The state and input names a pair file gives are its library's.
+
+    Raises:
+        ConfigError: A push tolerance names no state, or an unrealised input no input, of
+            the library's ``reference``; the message names the pair file and the field.
+    """
+    shown = f"pairs/{description.name}.toml"
+    push = description.stages.push_weights
+    for name in push.tolerances if push is not None else {}:
+        if name not in reference.state_names:
+            raise ConfigError(
+                f"{shown}: field 'stages.push_weights.tolerances.{name}': no such state in "
+                f"the library; allowed: {', '.join(reference.state_names)}"
+            )
+    for name in description.mpc.unrealised_inputs:
+        if name not in reference.input_names:
+            raise ConfigError(
+                f"{shown}: field 'mpc.unrealised_inputs': '{name}' is no input of the "
+                f"library; allowed: {', '.join(reference.input_names)}"
+            )

@@ -103,7 +103,7 @@ from ridempc.mpc.manoeuvre import (
     ManoeuvreSelector,
     StateLayout,
 )
-from ridempc.mpc.pairs import load_mpc_pair
+from ridempc.mpc.pairs import check_library_names, load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
@@ -256,6 +256,7 @@ class MpcRider(Controller):
             robot.name, board, first.library_kind, first.target, settings
         )
         names = self.mpc.reference.input_names
+        check_library_names(self.pair.description, self.mpc.reference)
         # Board inputs of the library that this rider does not realise (the pair file's
         # ``unrealised_inputs``), held at zero in the MPC.
         unrealised = self.pair.description.mpc.unrealised_inputs

@@ -142,5 +142,5 @@ def make_pair(description: PairDescription) -> Pair:
         description.robot,
         description.board,
         description.trajopt.default_targets,
-        description.trajopt.options,
+        description.trajopt.problem_options(),
     )

@@ -147,7 +147,7 @@ def _warm(problem: TrajectoryProblem, neighbour: Neighbour) -> Guess:
 def make_pair(description: PairDescription) -> Pair:
     """The :class:`Pair` a ``skate`` pair file describes (its targets and option defaults)."""
     robot_name, board_name = description.robot, description.board
-    defaults = dict(description.trajopt.options)
+    defaults = dict(description.trajopt.problem_options())
 
     def check(spec: EntrySpec) -> None:
         if spec.kind not in ("accelerate", "repush"):

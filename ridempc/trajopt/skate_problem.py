@@ -90,7 +90,7 @@ class SkateOptions:
     Attributes:
         dt: Grid step [s].
         friction: Foot friction coefficient :math:`\\mu` [-].
-        pusher: Contact site of the pushing foot (the pair file's ``trajopt.options``).
+        pusher: Contact site of the pushing foot (the pair file's ``trajopt.pusher``).
         period: Push period [s] (1.2 s in the paper).
         sweep: Distance the pushing foot sweeps along the ground per push [m].
         speed_per_stride: Speed gained per push, which sets the number of strides [m/s].
