@@ -125,6 +125,7 @@ class LinearMpc:
             reference.input_names,
             pair.weight / len(pair.contacts),
             self.settings.weights,
+            base=pair.base,
         )
         self._fixed = self._fixed_indices(self.settings.fixed_inputs)
         self.structure = QPStructure(

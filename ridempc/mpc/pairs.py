@@ -15,7 +15,7 @@ import math
 from collections.abc import Callable, Mapping
 from functools import cache, lru_cache, partial
 from types import MappingProxyType
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import casadi as ca
 import numpy as np
@@ -72,6 +72,7 @@ class MpcPair(NamedTuple):
         max_force: Largest normal force of one contact, :math:`f_{max}` [N] (the library's).
         weight: The robot's weight [N] (forces are weighed in units of its share per contact).
         description: The pair file it was built from (its WBC settings and stages).
+        base: The robot's base body, whose Z-Y-X angles the states carry (``<base>_roll``).
         pyramid: The friction pyramid's shape in the MPC and the whole-body QP
             (:data:`ridempc.friction.SHAPES`): ``diamond`` where line feet must twist a
             platform to turn it, ``box`` elsewhere.
@@ -125,6 +126,7 @@ class MpcPair(NamedTuple):
     max_force: float
     weight: float
     description: PairDescription
+    base: str
     pyramid: str = "box"
     tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
     force_time_constant: float | None = None
@@ -199,6 +201,7 @@ def _skate(description: PairDescription) -> MpcPair:
         limits,
         2.0 * weight,
         weight,
+        base=robot.base,
         settle=(
             partial(settle_over_feet, robot=robot, duration=settle.duration)
             if settle is not None
@@ -222,9 +225,9 @@ def _ride(description: PairDescription) -> MpcPair:
     weight = rider.body.mass * GRAVITY
     tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
     loaded = load_board(board)
-    params = loaded.params if loaded is not None else None
-    if description.stages.tipping is not None and isinstance(params, HovershoesParameters):
-        ratio = 0.5 * params.wheel_width / params.platform_height
+    if description.stages.tipping is not None:  # a board with shoes (the stage's check)
+        shoes = cast(HovershoesParameters, loaded.params if loaded is not None else None)
+        ratio = 0.5 * shoes.wheel_width / shoes.platform_height
         platform_of = layout["platform_of"]
         tipping = tuple(
             (tuple(k for k, p in enumerate(platform_of) if p == i), ratio)
@@ -237,6 +240,7 @@ def _ride(description: PairDescription) -> MpcPair:
         limits,
         weight,
         weight,
+        base=rider.body.base,
         tipping=tipping,
         **_settings(description),
     )

@@ -277,7 +277,9 @@ class MpcRider(Controller):
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_names(reference.state_names)
-        self.map = StateMap(self.pinocchio, reference.state_names, self.layout.prefixes)
+        self.map = StateMap(
+            self.pinocchio, reference.state_names, self.layout.prefixes, base=self.pair.base
+        )
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
         # achilles-rod constraint) drives the QP off (see the WBC's tests).
@@ -357,6 +359,10 @@ class MpcRider(Controller):
             if self.roll_observer is not None and self.pair.stance_roll is not None
             else None
         )
+        # Feet per side of the deck for a rider standing on it on two sides of feet (a
+        # quadruped's two), 0 for one foot a side: the roll observer's and the stance's sides.
+        n_feet = len(robot.params.foot_bodies)
+        self._side_feet = n_feet // 2 if n_feet >= 4 and n_feet % 2 == 0 else 0
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -673,16 +679,16 @@ class MpcRider(Controller):
         """Whether both feet of one side (left or right of the deck's centre line, by their
         estimated places) are off the deck or planned within 1 N of the least force."""
         board, plan = estimate.board, self._plan
-        if board is None or plan is None or len(estimate.foot_position) != 4:
+        side, index = self._side_feet, self.mpc.reference.force_index
+        if board is None or plan is None or not side:
             return False
-        index = self.mpc.reference.force_index
-        if len(index) != 4:
+        if len(estimate.foot_position) != 2 * side or len(index) != 2 * side:
             return False
         contact = np.asarray(estimate.contact, dtype=bool)
         light = ~contact | (plan.first_input[index[:, 2]] <= self._least_force() + 1.0)
         across = _to_deck(board.yaw, estimate.foot_position[:, :2])[:, 1]
         order = np.argsort(across)
-        return bool(light[order[:2]].all() or light[order[2:]].all())
+        return bool(light[order[:side]].all() or light[order[side:]].all())
 
     def _stance_roll(
         self, roll: Array, estimate: EstimatedState, now: float, balancing: bool
@@ -697,7 +703,8 @@ class MpcRider(Controller):
             limit.reset()
             return roll
         feet = np.asarray(estimate.foot_position, dtype=float)
-        if len(feet) != 4 or not np.all(estimate.contact) or self._plan is None:
+        four = bool(self._side_feet) and len(feet) == 2 * self._side_feet
+        if not four or not np.all(estimate.contact) or self._plan is None:
             return np.clip(roll, *limit.last)
         com = self.map.com(estimate)
         centre = feet[:, :2].mean(axis=0)

@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["INPUT_TOLERANCES", "STATE_TOLERANCES", "bryson_weights"]
+__all__ = ["BASE_TOLERANCE", "INPUT_TOLERANCES", "STATE_TOLERANCES", "bryson_weights"]
 
 Array = NDArray[np.float64]
 
@@ -25,7 +25,6 @@ Array = NDArray[np.float64]
 STATE_TOLERANCES: tuple[tuple[str, float], ...] = (
     (r"^com_z$", 0.01),
     (r"_(x|y)$", 0.05),  # horizontal positions of the rider and the board
-    (r"^(trunk|pelvis)_(roll|pitch)$", 0.02),
     (r"_(yaw|psi)$", 0.05),
     (r"_roll$", 0.01),  # deck roll: the tracked command (roll RMSE 0.0224 rad at 0.02)
     (r"_theta$", 0.1),  # platform pitch: the rider leans the platforms to ride
@@ -35,6 +34,9 @@ STATE_TOLERANCES: tuple[tuple[str, float], ...] = (
     (r"_(rate|dot)$", 1.0),  # the boards' fast roll, pitch and yaw rates
     (r"^q_", 0.1),
 )
+# [rad] the rider's base roll and pitch (``<base>_roll``, ``<base>_pitch``), before the table
+# (the deck's roll is tracked tighter, the table's ``_roll$``)
+BASE_TOLERANCE: float = 0.02
 # (pattern, accepted deviation) of the inputs; None: the weight per contact [N].
 INPUT_TOLERANCES: tuple[tuple[str, float | None], ...] = (
     (r"^f_", None),
@@ -61,6 +63,7 @@ def bryson_weights(
     input_names: Sequence[str],
     force_scale: float,
     overrides: Mapping[str, float] | None = None,
+    base: str | None = None,
 ) -> tuple[Array, Array]:
     """Diagonals of :math:`Q` and :math:`R`, :math:`1/\\sigma^2` per name.
 
@@ -69,11 +72,13 @@ def bryson_weights(
         input_names: The pair's input names.
         force_scale: Accepted deviation of a force component [N] (the weight per contact).
         overrides: Weights by exact state or input name (replacing the table's).
+        base: The rider's base body, whose roll and pitch take :data:`BASE_TOLERANCE`.
 
     Raises:
         KeyError: An override names neither a state nor an input.
     """
-    q = 1.0 / _tolerances(state_names, STATE_TOLERANCES, force_scale) ** 2
+    angles = [(f"^{re.escape(base)}_(roll|pitch)$", BASE_TOLERANCE)] if base is not None else []
+    q = 1.0 / _tolerances(state_names, [*angles, *STATE_TOLERANCES], force_scale) ** 2
     r = 1.0 / _tolerances(input_names, INPUT_TOLERANCES, force_scale) ** 2
     for name, weight in (overrides or {}).items():
         if name in state_names:

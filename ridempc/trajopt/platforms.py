@@ -20,7 +20,7 @@ lower). Each class is data plus the few functions the ride problem calls.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import casadi as ca
 import numpy as np
@@ -211,7 +211,9 @@ def wheeled_board(board: Board, pitch_limit: float = 0.25) -> WheeledBoard:
         raise ConfigError(
             f"{board.folder / 'board.toml'}: no [reduced] table; run `ridempc board identify`"
         )
-    if isinstance(params, HovershoesParameters):
+    features = board.kind.features
+    if "shoes" in features:
+        params = cast(HovershoesParameters, params)
         assert params.reduced is not None
         names = tuple(f"{side}_{n}" for side in ("left", "right") for n in SHOE_STATE)
         return HovershoesBoard(
@@ -227,14 +229,15 @@ def wheeled_board(board: Board, pitch_limit: float = 0.25) -> WheeledBoard:
             reduced=params.reduced,
             shoe_mass=board.mass / 2.0,
         )
-    if isinstance(params, SegwayParameters):
+    if "knee_bar" in features:
+        params = cast(SegwayParameters, params)
         assert params.reduced is not None
         return SegwayBoard(
             name=board.name,
             top=params.platform_height,
             speed_limit=params.top_speed,
             pitch_limit=pitch_limit,
-            state_names=tuple(f"segway_{n}" for n in SEGWAY_STATE),
+            state_names=tuple(f"{board.name}_{n}" for n in SEGWAY_STATE),
             input_names=("knee_bar",),
             input_bound=np.array([np.radians(params.knee_bar_range)]),
             yaw_torque_limit=float("inf"),

@@ -80,7 +80,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-_TRUNK = rigid_body_state_names("trunk")
 
 
 @dataclass(frozen=True)
@@ -291,7 +290,7 @@ def inward_distances(point: Any, vertices: list[Any], turn: float) -> Any:
 
 
 def _names(robot: RigidBodyRobot) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    states = (*_TRUNK, *(f"q_{j}" for j in robot.joints), *BOARD_STATE)
+    states = (*rigid_body_state_names(robot.base), *(f"q_{j}" for j in robot.joints), *BOARD_STATE)
     forces = tuple(f"f_{foot}_{a}" for foot in robot.feet for a in "xyz")
     return states, (*forces, *(f"qd_{j}" for j in robot.joints))
 
@@ -508,7 +507,7 @@ def build_skate_problem(
         return terms
 
     metadata = {
-        "pair": f"{robot.name}-skateboard",
+        "pair": f"{robot.name}-{board.name}",
         "kind": "repush" if o.start_speed > 0.0 else "accelerate",
         "target": float(target),
         "options": asdict(o),

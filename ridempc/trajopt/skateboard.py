@@ -26,7 +26,7 @@ model (:mod:`ridempc.boards.skateboard.reduced`) with ``xp = casadi``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import casadi as ca
 
@@ -63,6 +63,7 @@ class SkateboardModel:
         viscous_drag: Viscous rolling resistance :math:`c_v` [N s / m].
         friction_sharpness: :math:`k` of eq. (10) [s / m].
         reduced: The identified roll and steering model.
+        name: The board's name (its description's).
     """
 
     mass: float
@@ -74,6 +75,7 @@ class SkateboardModel:
     viscous_drag: float
     friction_sharpness: float
     reduced: SkateboardReducedParameters
+    name: str
 
 
 def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> SkateboardModel:
@@ -82,9 +84,9 @@ def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> Skateboa
     Raises:
         ConfigError: The board is not a skateboard or has no identified reduced model.
     """
-    params = board.params
-    if not isinstance(params, SkateboardParameters):
-        raise ConfigError(f"board '{board.name}' is not a skateboard")
+    if "deck_roll" not in board.kind.features:
+        raise ConfigError(f"board '{board.name}' is not a skateboard (no rolling deck)")
+    params = cast(SkateboardParameters, board.params)
     if params.reduced is None:
         raise ConfigError(
             f"{board.folder / 'board.toml'}: no [reduced] table; run `ridempc board identify`"
@@ -100,6 +102,7 @@ def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> Skateboa
         viscous_drag=4.0 * params.wheel_damping / r**2,
         friction_sharpness=friction_sharpness,
         reduced=params.reduced,
+        name=board.name,
     )
 
 
