@@ -51,8 +51,8 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
    (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the reference's
    joint angles where the library has them, the dog's, else the robot's riding posture
-   on the board, its stance unless a riding keyframe is given: held at the stance, the
-   dog's trunk stayed 3-4 cm above the reference's crouch before a push). A foot the
+   on the board, its stance unless a riding keyframe is given: the stance would hold the
+   dog's trunk above the reference's crouch). A foot the
    schedule puts on the ground (a push-off) stands on the ground for the WBC and the
    estimator, not on the board; a foot it lifts is left out of the board's estimate even
    if it touches something;
@@ -178,8 +178,7 @@ def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
     """The platforms that the rider's push moves, as the WBC sees them: each Hovershoe, the
     bare shoe with its identified drive (:mod:`ridempc.wbc.platforms`); the skateboard's deck,
     its translating mass with no drive (3.2 kg under a 9 kg dog: taken for ground, the deck
-    feet pushed it 0.24 m/s past its plan as the pusher returned, and push-off-0.7 fell at
-    2.55 s instead of 3.41 s); none otherwise."""
+    feet would push it past its plan as the pusher returns); none otherwise."""
     features = board.kind.features if board is not None else frozenset()
     if board is not None and "deck_roll" in features:
         return (RollingPlatform(mass=skateboard_model(board).mass, drive=0.0),)
@@ -263,8 +262,7 @@ class MpcRider(Controller):
         pinned = {n: 0.0 for n in unrealised if n in names}
         self.mpc.fix_inputs({**pinned, **self.mpc.settings.fixed_inputs})
         # Yaw-rate commands are laid over the reference only where the rider can turn the
-        # board (not the Segway with its knee bar pinned: it rode yaw-steps straight, and
-        # with the turn laid over it fell at 7.7 s).
+        # board (not the Segway with its knee bar pinned, which the lean turns).
         self.steers = self.mpc.steers()
         # A board with a yaw rate that the rider cannot drive (the Segway's): the library
         # frame turns with its heading (StateMap.follow_sideways).

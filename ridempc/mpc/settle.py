@@ -4,9 +4,8 @@ The skateboard library's entries end with the centre of mass 6.4-8.7 cm ahead of
 stood at the start, over the four feet (nothing in the trajectory optimisation's cost keeps
 it back: 0.3-1.0 m/s; 7.3-9.5 cm in the library before ``SkateOptions.liftoff_force``), and
 a reference held at its last node (:func:`~ridempc.mpc.reference.steady_riding`) keeps the
-rider there for the rest of the ride. With that earlier library the dog then stood with
-80-97 % of its weight on its front feet, and on push-off-1.0, seed 25, a rear foot carrying
-0-3 N drifted off the rolling deck at 14.7 s and the ride fell.
+rider there for the rest of the ride, its weight on its front feet and its rear feet light
+enough to drift off a rolling deck (``docs/tuning.md``).
 
 :func:`settle_over_feet` gives the reference an offset that grows after its end, over
 ``duration`` [s], by a smoothstep :math:`s(\\tau) = 3\\tau^2 - 2\\tau^3`,
