@@ -11,6 +11,7 @@ import pytest
 
 from ridempc import cli
 from ridempc.errors import ConfigError, UnknownNameError
+from ridempc.library.store import library_folder
 from ridempc.mpc.pairs import check_library_names, load_mpc_pair, mpc_pair_names
 from ridempc.mpc.reference import select_reference
 from ridempc.pair_description import (
@@ -21,7 +22,7 @@ from ridempc.pair_description import (
     pair_description_names,
     read_pair_file,
 )
-from ridempc.paths import pairs_dir
+from ridempc.paths import motion_library_dir, pairs_dir
 from ridempc.trajopt.pairs import load_pair, pair_names
 
 PAIRS = pair_description_names()
@@ -76,6 +77,23 @@ def test_the_names_a_pair_file_gives_are_its_librarys() -> None:
     stages = description.stages.model_copy(update={"push_weights": push})
     with pytest.raises(ConfigError, match="'stages.push_weights.tolerances.board_speed'"):
         check_library_names(description.model_copy(update={"stages": stages}), reference)
+
+
+def test_the_library_folder_is_the_one_the_pair_file_names(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    assert library_folder("cassie", "segway") == motion_library_dir() / "cassie-segway"
+    assert library_folder("cassie", "skateboard").name == "cassie-skateboard"  # no pair file
+    folder = tmp_path / "pairs"
+    shutil.copytree(pairs_dir(), folder)
+    path = folder / "cassie-segway.toml"
+    path.write_text(path.read_text().replace('library = "cassie-segway"', 'library = "other"'))
+    monkeypatch.setattr("ridempc.pair_description.pairs_dir", lambda: folder)
+    load_pair_description.cache_clear()
+    try:
+        assert library_folder("cassie", "segway", tmp_path) == tmp_path / "other"
+    finally:
+        load_pair_description.cache_clear()
 
 
 def test_an_undescribed_pair_is_an_unknown_name() -> None:
