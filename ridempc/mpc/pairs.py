@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards import load_board
+from ridempc.boards.canonical import BoardState
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.errors import ConfigError
 from ridempc.mpc.buffered import BufferedFunction
@@ -73,6 +74,8 @@ class MpcPair(NamedTuple):
         weight: The robot's weight [N] (forces are weighed in units of its share per contact).
         description: The pair file it was built from (its WBC settings and stages).
         base: The robot's base body, whose Z-Y-X angles the states carry (``<base>_roll``).
+        board_states: Per board state name, its platform and canonical quantity
+            (:mod:`ridempc.boards.canonical`), from the board's reduced model.
         pyramid: The friction pyramid's shape in the MPC and the whole-body QP
             (:data:`ridempc.friction.SHAPES`): ``diamond`` where line feet must twist a
             platform to turn it, ``box`` elsewhere.
@@ -127,6 +130,7 @@ class MpcPair(NamedTuple):
     weight: float
     description: PairDescription
     base: str
+    board_states: Mapping[str, BoardState]
     pyramid: str = "box"
     tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
     force_time_constant: float | None = None
@@ -202,6 +206,7 @@ def _skate(description: PairDescription) -> MpcPair:
         2.0 * weight,
         weight,
         base=robot.base,
+        board_states=MappingProxyType(board.board_states()),
         settle=(
             partial(settle_over_feet, robot=robot, duration=settle.duration)
             if settle is not None
@@ -241,6 +246,7 @@ def _ride(description: PairDescription) -> MpcPair:
         weight,
         weight,
         base=rider.body.base,
+        board_states=MappingProxyType(wheeled.board_states()),
         tipping=tipping,
         **_settings(description),
     )

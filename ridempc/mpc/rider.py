@@ -83,6 +83,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState, board_state_columns
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.skateboard.reduced import yaw_rate
 from ridempc.boards.skateboard.steering import RollSteering
@@ -98,7 +99,6 @@ from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
     HOLD,
     REPUSH,
-    YAW_RATE_SUFFIXES,
     Manoeuvre,
     ManoeuvreSelector,
     StateLayout,
@@ -266,7 +266,9 @@ class MpcRider(Controller):
         self.steers = self.mpc.steers()
         # A board with a yaw rate that the rider cannot drive (the Segway's): the library
         # frame turns with its heading (StateMap.follow_sideways).
-        yaw_rates = any(n.endswith(YAW_RATE_SUFFIXES) for n in self.mpc.reference.state_names)
+        # where each board state is in the MPC's state, by its canonical quantity
+        columns = board_state_columns(self.mpc.reference.state_names, self.pair.board_states)
+        yaw_rates = any(state.quantity == "yaw_rate" for state in columns)
         self._follows_heading = yaw_rates and not self.steers
         # A board turned by a bar the legs push (the Segway's knee bar, held at zero in the
         # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
@@ -333,9 +335,12 @@ class MpcRider(Controller):
             else None
         )
         self._guidance = stages.guidance is not None  # shoe headings turned onto their lines
-        n = self.layout.names  # each shoe's (x, y, heading, speed) indices in the MPC's state
+        quantities = ("x", "y", "heading", "speed")  # each shoe's, in the MPC's state
         self._shoe_columns = (
-            tuple((n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes)
+            tuple(
+                tuple(columns[BoardState(k, q)] for q in quantities)
+                for k in sorted({state.platform for state in columns})
+            )
             if self.shoes is not None
             else ()
         )
@@ -346,10 +351,11 @@ class MpcRider(Controller):
         # a yaw-rate command steered by the deck's roll, eq. (14) inverted
         self.roll_steering = RollSteering(gain=steers.steer_gain) if steers is not None else None
         self._blend: SwitchBlend | None = None  # a re-push's reference blended in
-        index, gain = self.layout.names, self.pair.roll_observer
+        gain = self.pair.roll_observer
+        roll, roll_rate = BoardState(0, "roll"), BoardState(0, "roll_rate")  # the deck's
         self.roll_observer = (
-            RollObserver(index["board_roll"], index["board_roll_rate"], deck, gain)
-            if deck is not None and gain is not None and "board_roll_rate" in index
+            RollObserver(columns[roll], columns[roll_rate], deck, gain)
+            if deck is not None and gain is not None and roll_rate in columns
             else None
         )
         self.stance = (

@@ -27,16 +27,28 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState, canonical_board_states
 from ridempc.boards.hovershoes.parameters import HovershoesParameters, HovershoesReducedParameters
 from ridempc.boards.hovershoes.reduced import STATE_NAMES as SHOE_STATE
+from ridempc.boards.hovershoes.reduced import STATE_QUANTITIES as SHOE_QUANTITIES
 from ridempc.boards.hovershoes.reduced import contact_torques, shoe_dynamics
 from ridempc.boards.segway.parameters import SegwayParameters, SegwayReducedParameters
 from ridempc.boards.segway.reduced import STATE as SEGWAY_STATE
+from ridempc.boards.segway.reduced import STATE_QUANTITIES as SEGWAY_QUANTITIES
 from ridempc.boards.segway.reduced import segway_dynamics
 from ridempc.errors import ConfigError
 from ridempc.trajopt.rotations import rotation_z, stack3x3
 
-__all__ = ["HovershoesBoard", "SegwayBoard", "WheeledBoard", "platform_pushes", "wheeled_board"]
+__all__ = [
+    "SIDES",
+    "HovershoesBoard",
+    "SegwayBoard",
+    "WheeledBoard",
+    "platform_pushes",
+    "wheeled_board",
+]
+
+SIDES: tuple[str, ...] = ("left", "right")  # the Hovershoes' shoes, in platform order
 
 Array = NDArray[np.float64]
 
@@ -99,7 +111,11 @@ class HovershoesBoard(_Common):
 
     @property
     def n_platforms(self) -> int:
-        return 2
+        return len(SIDES)
+
+    def board_states(self) -> dict[str, BoardState]:
+        """Each state name as its canonical quantity, per shoe (left, right)."""
+        return canonical_board_states(tuple(f"{side}_" for side in SIDES), SHOE_QUANTITIES)
 
     def platform_state(self, xb: Any, platform: int) -> Any:
         return xb[7 * platform : 7 * platform + 7]
@@ -154,6 +170,10 @@ class SegwayBoard(_Common):
     @property
     def n_platforms(self) -> int:
         return 1
+
+    def board_states(self) -> dict[str, BoardState]:
+        """Each state name as its canonical quantity (one platform)."""
+        return canonical_board_states((f"{self.name}_",), SEGWAY_QUANTITIES)
 
     def pose(self, xb: Any, platform: int) -> tuple[Any, Any]:
         rotation = rotation_z(xb[2], ca) @ _rotation_y(xb[3])
@@ -215,7 +235,7 @@ def wheeled_board(board: Board, pitch_limit: float = 0.25) -> WheeledBoard:
     if "shoes" in features:
         params = cast(HovershoesParameters, params)
         assert params.reduced is not None
-        names = tuple(f"{side}_{n}" for side in ("left", "right") for n in SHOE_STATE)
+        names = tuple(f"{side}_{n}" for side in SIDES for n in SHOE_STATE)
         return HovershoesBoard(
             name=board.name,
             top=params.platform_height,

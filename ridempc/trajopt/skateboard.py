@@ -31,12 +31,20 @@ from typing import Any, cast
 import casadi as ca
 
 from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState, canonical_board_states
 from ridempc.boards.skateboard.parameters import SkateboardParameters, SkateboardReducedParameters
 from ridempc.boards.skateboard.reduced import dubins_rates, roll_acceleration
 from ridempc.errors import ConfigError
 from ridempc.trajopt.rotations import rotation_x, rotation_z
 
-__all__ = ["BOARD_STATE", "SkateboardModel", "deck_frame", "skateboard_model", "skateboard_rates"]
+__all__ = [
+    "BOARD_STATE",
+    "DECK_QUANTITIES",
+    "SkateboardModel",
+    "deck_frame",
+    "skateboard_model",
+    "skateboard_rates",
+]
 
 BOARD_STATE: tuple[str, ...] = (
     "board_x",
@@ -46,6 +54,16 @@ BOARD_STATE: tuple[str, ...] = (
     "board_roll",
     "board_roll_rate",
 )
+DECK_PREFIX = "board_"  # the deck's states' prefix in BOARD_STATE
+# What each deck state is, by its canonical name (ridempc.boards.canonical).
+DECK_QUANTITIES: dict[str, str] = {
+    "x": "x",
+    "y": "y",
+    "yaw": "heading",
+    "v": "speed",
+    "roll": "roll",
+    "roll_rate": "roll_rate",
+}
 
 
 @dataclass(frozen=True)
@@ -76,6 +94,10 @@ class SkateboardModel:
     friction_sharpness: float
     reduced: SkateboardReducedParameters
     name: str
+
+    def board_states(self) -> dict[str, BoardState]:
+        """Each of :data:`BOARD_STATE` as its canonical quantity (one platform, the deck)."""
+        return canonical_board_states((DECK_PREFIX,), DECK_QUANTITIES)
 
 
 def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> SkateboardModel:
