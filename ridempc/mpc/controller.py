@@ -126,6 +126,7 @@ class LinearMpc:
             pair.weight / len(pair.contacts),
             self.settings.weights,
             base=pair.base,
+            board_states=pair.board_states,
         )
         self._fixed = self._fixed_indices(self.settings.fixed_inputs)
         self.structure = QPStructure(
