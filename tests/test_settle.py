@@ -12,6 +12,7 @@ import pytest
 
 from ridempc.errors import ConfigError
 from ridempc.mpc.controller import LinearMpc
+from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.settle import settle_over_feet
 from ridempc.pair_description import load_pair_description
 from ridempc.trajopt.rigid_body import feet_world
@@ -88,7 +89,7 @@ def test_a_reference_without_one_board_cannot_settle() -> None:
     assert shoes.settle_states is None  # the Hovershoes do not settle
     robot, _ = skate_models("cyberdog2", "skateboard")
     with pytest.raises(ConfigError, match="settle"):
-        settle_over_feet(shoes, robot, 1.0)
+        settle_over_feet(shoes, robot, 1.0, load_mpc_pair("cassie", "hovershoes").board_states)
 
 
 def test_a_settle_the_legs_cannot_reach_is_refused(settled) -> None:
@@ -100,5 +101,5 @@ def test_a_settle_the_legs_cannot_reach_is_refused(settled) -> None:
     states[0, reference.state_names.index("com_x")] -= 1.0
     far = replace(reference, states=states, settle_states=None, settle_inputs=None)
     with pytest.raises(ConfigError, match="no joint angles keep the feet in place") as info:
-        settle_over_feet(far, robot, 1.0)
+        settle_over_feet(far, robot, 1.0, load_mpc_pair("cyberdog2", "skateboard").board_states)
     assert "\n" not in str(info.value)

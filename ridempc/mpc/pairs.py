@@ -208,7 +208,12 @@ def _skate(description: PairDescription) -> MpcPair:
         base=robot.base,
         board_states=MappingProxyType(board.board_states()),
         settle=(
-            partial(settle_over_feet, robot=robot, duration=settle.duration)
+            partial(
+                settle_over_feet,
+                robot=robot,
+                duration=settle.duration,
+                board_states=board.board_states(),
+            )
             if settle is not None
             else None
         ),
