@@ -106,8 +106,7 @@ LEAN_GAINS = LoopGains(
     ki=0.1,  # [m per rad]
     integral_limit=0.08,  # [m]
     max_shift=0.1,  # [m]
-    # [m/s] twice the pd rider's: riding, the path takes the centre of mass there (yaw-steps
-    # seed 0 with the heading carried by the gyro, yaw-rate RMSE 0.104 at 0.1, 0.082 at 0.2)
+    # [m/s] twice the pd rider's: riding, the path takes the centre of mass there
     max_rate=0.2,
     filter_hz=5.0,  # [Hz] on the yaw rate
 )
