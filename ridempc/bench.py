@@ -3,8 +3,8 @@
 For each robot-board pair with a pair file (:func:`ridempc.mpc.pairs.mpc_pair_names`):
 
 1. **Record.** The ``mpc`` rider rides the pair's benchmark scenario
-   (:data:`BENCH_SCENARIOS`: a manoeuvre, not standing still, where the QPs are hardest;
-   ``scenario`` overrides it) for ``seconds`` of simulated time (seed 0): every MPC
+   (its pair file's ``bench_scenario``: a manoeuvre, not standing still, where the QPs are
+   hardest; ``scenario`` overrides it) for ``seconds`` of simulated time (seed 0): every MPC
    problem (30 Hz) and every WBC input (estimate and targets, 500 Hz) is kept, and the
    loop's wall time gives the closed-loop **real-time factor** (simulated over wall time;
    above 1 is faster than real time). The ride's own MPC ticks are timed too (**MPC tick**:
@@ -83,13 +83,6 @@ from ridempc.tickprofile import DEFAULT_TOP, PartProfiler, profile_table
 
 __all__ = ["PairBench", "bench", "bench_table"]
 
-# Per pair, the scenario recorded: the skateboard's push-off (its two pushes, a foot
-# lifting and landing, are done by 4 s) and Cassie's first speed step (3-4 s).
-BENCH_SCENARIOS: dict[str, str] = {
-    "cyberdog2-skateboard": "push-off-0.5",
-    "cassie-segway": "velocity-steps",
-    "cassie-hovershoes": "velocity-steps",
-}
 DEFAULT_SECONDS: float = 6.0
 PASSES: int = 3  # the recorded problems are solved this many times (module docstring)
 
@@ -153,9 +146,12 @@ def _stats(values: Sequence[float]) -> tuple[float, float]:
 
 
 def _scenario_of(pair: str, scenario: str | None) -> str:
-    """The scenario recorded for ``pair``: ``scenario`` if given, else its
-    :data:`BENCH_SCENARIOS` entry (``stand-still`` for a pair without one)."""
-    return scenario or BENCH_SCENARIOS.get(pair, "stand-still")
+    """The scenario recorded for ``pair``: ``scenario`` if given, else its pair file's
+    ``bench_scenario``."""
+    from ridempc.pair_description import load_pair_description
+
+    robot, board = pair.split("-", 1)
+    return scenario or load_pair_description(robot, board).bench_scenario
 
 
 BUDGET_PARTS: tuple[str, ...] = ("simulation", "estimator", "mpc", "wbc", "rider_rest")
@@ -751,8 +747,8 @@ def bench(
     wbc_solver: str | None = None,
     profile: bool = False,
 ) -> list[PairBench]:
-    """Benchmark ``pairs`` (default: every pair with an MPC) on their
-    :data:`BENCH_SCENARIOS` (or ``scenario`` for all), with ``wbc_solver`` in the
+    """Benchmark ``pairs`` (default: every pair with an MPC) on their pair files'
+    ``bench_scenario`` (or ``scenario`` for all), with ``wbc_solver`` in the
     whole-body QP, print and optionally save; with ``profile``, each pair's hottest
     functions per part of the tick too.
 

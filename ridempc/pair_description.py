@@ -230,6 +230,13 @@ class PairDescription(_Frozen):
         pattern=r"^[a-z0-9][a-z0-9_.-]*$",
         description="The motion library's folder in ``motion_library/``.",
     )
+    bench_scenario: str = Field(
+        default="stand-still",
+        pattern=r"^[a-z0-9][a-z0-9_.-]*$",
+        description=(
+            "The scenario ``ridempc bench`` records: a manoeuvre, where the QPs are hardest."
+        ),
+    )
     trajopt: TrajoptSection
     mpc: MpcSection
     wbc: WbcSection
