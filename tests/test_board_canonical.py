@@ -32,6 +32,8 @@ def test_a_wheeled_boards_states_are_named_by_quantity(name: str) -> None:
         assert model.heading_index(k) == columns[BoardState(k, "heading")]
         for quantity in ("x", "y", "pitch", "pitch_rate", "yaw_rate"):
             assert BoardState(k, quantity) in columns
+        prefix = model.platform_prefixes()[k]
+        assert all(n.startswith(prefix) for n, s in states.items() if s.platform == k)
 
 
 def test_the_decks_states_are_named_by_quantity() -> None:
@@ -40,6 +42,7 @@ def test_the_decks_states_are_named_by_quantity() -> None:
     assert set(states) == set(BOARD_STATE)
     columns = board_state_columns(BOARD_STATE, states)
     assert {s.quantity for s in columns} == {"x", "y", "heading", "speed", "roll", "roll_rate"}
+    assert all(n.startswith(model.platform_prefixes()[0]) for n in BOARD_STATE)
 
 
 def test_an_unknown_quantity_is_refused() -> None:

@@ -76,6 +76,7 @@ class MpcPair(NamedTuple):
         base: The robot's base body, whose Z-Y-X angles the states carry (``<base>_roll``).
         board_states: Per board state name, its platform and canonical quantity
             (:mod:`ridempc.boards.canonical`), from the board's reduced model.
+        platform_prefixes: Each platform's prefix of its state names, in platform order.
         pyramid: The friction pyramid's shape in the MPC and the whole-body QP
             (:data:`ridempc.friction.SHAPES`): ``diamond`` where line feet must twist a
             platform to turn it, ``box`` elsewhere.
@@ -131,6 +132,7 @@ class MpcPair(NamedTuple):
     description: PairDescription
     base: str
     board_states: Mapping[str, BoardState]
+    platform_prefixes: tuple[str, ...]
     pyramid: str = "box"
     tipping: tuple[tuple[tuple[int, ...], float], ...] = ()
     force_time_constant: float | None = None
@@ -207,6 +209,7 @@ def _skate(description: PairDescription) -> MpcPair:
         weight,
         base=robot.base,
         board_states=MappingProxyType(board.board_states()),
+        platform_prefixes=board.platform_prefixes(),
         settle=(
             partial(
                 settle_over_feet,
@@ -252,6 +255,7 @@ def _ride(description: PairDescription) -> MpcPair:
         weight,
         base=rider.body.base,
         board_states=MappingProxyType(wheeled.board_states()),
+        platform_prefixes=wheeled.platform_prefixes(),
         tipping=tipping,
         **_settings(description),
     )

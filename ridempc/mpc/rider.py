@@ -276,7 +276,9 @@ class MpcRider(Controller):
         self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
-        self.layout = StateLayout.from_names(reference.state_names)
+        self.layout = StateLayout.from_pair(
+            reference.state_names, self.pair.platform_prefixes, self.pair.base
+        )
         self.map = StateMap(
             self.pinocchio, reference.state_names, self.layout.prefixes, base=self.pair.base
         )

@@ -113,9 +113,13 @@ class HovershoesBoard(_Common):
     def n_platforms(self) -> int:
         return len(SIDES)
 
+    def platform_prefixes(self) -> tuple[str, ...]:
+        """Each shoe's prefix of its state names, in platform order (left, right)."""
+        return tuple(f"{side}_" for side in SIDES)
+
     def board_states(self) -> dict[str, BoardState]:
         """Each state name as its canonical quantity, per shoe (left, right)."""
-        return canonical_board_states(tuple(f"{side}_" for side in SIDES), SHOE_QUANTITIES)
+        return canonical_board_states(self.platform_prefixes(), SHOE_QUANTITIES)
 
     def platform_state(self, xb: Any, platform: int) -> Any:
         return xb[7 * platform : 7 * platform + 7]
@@ -171,9 +175,13 @@ class SegwayBoard(_Common):
     def n_platforms(self) -> int:
         return 1
 
+    def platform_prefixes(self) -> tuple[str, ...]:
+        """The platform's prefix of its state names (the board's name)."""
+        return (f"{self.name}_",)
+
     def board_states(self) -> dict[str, BoardState]:
         """Each state name as its canonical quantity (one platform)."""
-        return canonical_board_states((f"{self.name}_",), SEGWAY_QUANTITIES)
+        return canonical_board_states(self.platform_prefixes(), SEGWAY_QUANTITIES)
 
     def pose(self, xb: Any, platform: int) -> tuple[Any, Any]:
         rotation = rotation_z(xb[2], ca) @ _rotation_y(xb[3])

@@ -95,9 +95,13 @@ class SkateboardModel:
     reduced: SkateboardReducedParameters
     name: str
 
+    def platform_prefixes(self) -> tuple[str, ...]:
+        """The deck's prefix of its state names."""
+        return (DECK_PREFIX,)
+
     def board_states(self) -> dict[str, BoardState]:
         """Each of :data:`BOARD_STATE` as its canonical quantity (one platform, the deck)."""
-        return canonical_board_states((DECK_PREFIX,), DECK_QUANTITIES)
+        return canonical_board_states(self.platform_prefixes(), DECK_QUANTITIES)
 
 
 def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> SkateboardModel:
