@@ -1,10 +1,10 @@
 """``ridempc bench``: MPC and WBC solve times on recorded problems, and other QP solvers.
 
-For each robot-board pair with an MPC library (:data:`ridempc.mpc.pairs.MPC_PAIRS`):
+For each robot-board pair with a pair file (:func:`ridempc.mpc.pairs.mpc_pair_names`):
 
 1. **Record.** The ``mpc`` rider rides the pair's benchmark scenario
-   (:data:`BENCH_SCENARIOS`: a manoeuvre, not standing still, where the QPs are hardest;
-   ``scenario`` overrides it) for ``seconds`` of simulated time (seed 0): every MPC
+   (its pair file's ``bench_scenario``: a manoeuvre, not standing still, where the QPs are
+   hardest; ``scenario`` overrides it) for ``seconds`` of simulated time (seed 0): every MPC
    problem (30 Hz) and every WBC input (estimate and targets, 500 Hz) is kept, and the
    loop's wall time gives the closed-loop **real-time factor** (simulated over wall time;
    above 1 is faster than real time). The ride's own MPC ticks are timed too (**MPC tick**:
@@ -83,13 +83,6 @@ from ridempc.tickprofile import DEFAULT_TOP, PartProfiler, profile_table
 
 __all__ = ["PairBench", "bench", "bench_table"]
 
-# Per pair, the scenario recorded: the skateboard's push-off (its two pushes, a foot
-# lifting and landing, are done by 4 s) and Cassie's first speed step (3-4 s).
-BENCH_SCENARIOS: dict[str, str] = {
-    "cyberdog2-skateboard": "push-off-0.5",
-    "cassie-segway": "velocity-steps",
-    "cassie-hovershoes": "velocity-steps",
-}
 DEFAULT_SECONDS: float = 6.0
 PASSES: int = 3  # the recorded problems are solved this many times (module docstring)
 
@@ -153,9 +146,12 @@ def _stats(values: Sequence[float]) -> tuple[float, float]:
 
 
 def _scenario_of(pair: str, scenario: str | None) -> str:
-    """The scenario recorded for ``pair``: ``scenario`` if given, else its
-    :data:`BENCH_SCENARIOS` entry (``stand-still`` for a pair without one)."""
-    return scenario or BENCH_SCENARIOS.get(pair, "stand-still")
+    """The scenario recorded for ``pair``: ``scenario`` if given, else its pair file's
+    ``bench_scenario``."""
+    from ridempc.pair_description import load_pair_description
+
+    robot, board = pair.split("-", 1)
+    return scenario or load_pair_description(robot, board).bench_scenario
 
 
 BUDGET_PARTS: tuple[str, ...] = ("simulation", "estimator", "mpc", "wbc", "rider_rest")
@@ -751,8 +747,8 @@ def bench(
     wbc_solver: str | None = None,
     profile: bool = False,
 ) -> list[PairBench]:
-    """Benchmark ``pairs`` (default: every pair with an MPC) on their
-    :data:`BENCH_SCENARIOS` (or ``scenario`` for all), with ``wbc_solver`` in the
+    """Benchmark ``pairs`` (default: every pair with an MPC) on their pair files'
+    ``bench_scenario`` (or ``scenario`` for all), with ``wbc_solver`` in the
     whole-body QP, print and optionally save; with ``profile``, each pair's hottest
     functions per part of the tick too.
 
@@ -764,16 +760,16 @@ def bench(
     from dataclasses import asdict
 
     from ridempc.errors import UnknownNameError
-    from ridempc.mpc.pairs import MPC_PAIRS
+    from ridempc.mpc.pairs import mpc_pair_names
 
     kind = QP_KINDS["wbc"]
     wbc_solver = kind.solver if wbc_solver is None else wbc_solver
     if wbc_solver not in kind.solvers:
         raise UnknownNameError("whole-body QP solver", wbc_solver, kind.solvers)
-    names = list(pairs) if pairs else list(MPC_PAIRS)
+    names = list(pairs) if pairs else list(mpc_pair_names())
     for name in names:
-        if name not in MPC_PAIRS:
-            raise UnknownNameError("robot-board pair for the MPC", name, MPC_PAIRS)
+        if name not in mpc_pair_names():
+            raise UnknownNameError("robot-board pair for the MPC", name, mpc_pair_names())
     from ridempc.scenarios import resolve_scenario
 
     recorded = {n: _scenario_of(n, scenario) for n in names}

@@ -235,6 +235,7 @@ def _bench(args: argparse.Namespace) -> int:
 def _list() -> int:
     from ridempc.boards import board_names
     from ridempc.controllers import controller_names
+    from ridempc.pair_description import pair_description_names
     from ridempc.robots import robot_names
     from ridempc.scenarios import scenario_applies, scenario_names
     from ridempc.sweep.distribution import distribution_boards, distribution_names
@@ -242,6 +243,7 @@ def _list() -> int:
     print("robots:      " + ", ".join(robot_names()))
     print("boards:      " + ", ".join(board_names()))
     print("controllers: " + ", ".join(controller_names()))
+    print("pairs:       " + ", ".join(pair_description_names()) + " (pairs/<robot>-<board>.toml)")
     print(
         "scenarios (robot 'none' with controller 'dead-weight' rides a board with a dead weight):"
     )

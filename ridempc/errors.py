@@ -45,8 +45,8 @@ def _bare(annotation: Any) -> Any:
             return annotation
 
 
-def _keys_at(model: Any, loc: tuple[Any, ...]) -> tuple[str, ...]:
-    """The keys a model takes in its table at ``loc`` (``()`` where that is not a model)."""
+def _keys_at(model: Any, loc: tuple[Any, ...]) -> tuple[str, ...] | None:
+    """The keys a model takes in its table at ``loc`` (None where that is not a model)."""
     node = _bare(model)
     for part in loc:
         origin, args = get_origin(node), get_args(node)
@@ -59,8 +59,8 @@ def _keys_at(model: Any, loc: tuple[Any, ...]) -> tuple[str, ...]:
             element = args[0] if len(args) == 1 or args[1] is Ellipsis else args[part]
             node = _bare(element) if part < len(args) or args[-1] is Ellipsis else None
         else:
-            return ()
-    return tuple(node.model_fields) if hasattr(node, "model_fields") else ()
+            return None
+    return tuple(node.model_fields) if hasattr(node, "model_fields") else None
 
 
 class RidempcError(Exception):
@@ -103,7 +103,8 @@ class ConfigError(RidempcError, ValueError):
         got = ""
         if first["type"] == "extra_forbidden":
             keys = _keys_at(model, tuple(first["loc"][:-1]))
-            message = "unknown key" + (f"; allowed: {', '.join(keys)}" if keys else "")
+            allowed = None if keys is None else ", ".join(keys) or "none"
+            message = "unknown key" + (f"; allowed: {allowed}" if allowed else "")
         elif first["type"] != "missing" and isinstance(first.get("input"), _SCALARS):
             got = f", got {_shown(first['input'])}"
         return cls(f"{path}:{field} {message}{got}{more}")

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["data_root", "robots_dir", "boards_dir", "motion_library_dir"]
+__all__ = ["data_root", "robots_dir", "boards_dir", "motion_library_dir", "pairs_dir"]
 
 _PACKAGE = Path(__file__).resolve().parent
 
 
 def data_root() -> Path:
-    """Folder holding ``robots/``, ``boards/`` and ``motion_library/``.
+    """Folder holding ``robots/``, ``boards/``, ``pairs/`` and ``motion_library/``.
 
     A wheel carries them inside the package (``ridempc/_data``); an editable install or a
     checkout finds them beside the package, at the repository's top level.
@@ -29,3 +29,7 @@ def boards_dir() -> Path:
 
 def motion_library_dir() -> Path:
     return data_root() / "motion_library"
+
+
+def pairs_dir() -> Path:
+    return data_root() / "pairs"

@@ -625,7 +625,7 @@ def test_swing_targets_follow_the_reference_feet_carried_by_the_board(
     model = WholeBodyModel(load_robot("cyberdog2"))
     feet = ReferenceFeet(model, reference.state_names, layout.base_prefix, layout.board_pose)
     assert feet.plans_feet
-    robot, board = skate_models()
+    robot, board = skate_models("cyberdog2", "skateboard")
     radius = float(np.mean(robot.foot_radius))
     on_deck = feet.points(reference.states[0])[:, 2]
     assert np.ptp(on_deck) < 2e-3 and on_deck[0] == pytest.approx(

@@ -427,11 +427,12 @@ def test_cassie_leans_into_a_planned_speed_step_on_the_hovershoes() -> None:
 
 
 def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
-    """Cassie's motor PD follows the WBC at a tenth of its gains (``tracking_gain_scale``);
+    """Cassie's motor PD follows the WBC at a tenth of its gains (the pair file's
+    ``tracking_gain_scale``);
     with the MPC she then stands on the Hovershoes (at full gains the stiff PD overrode the
-    QP's forces and she fell within 0.8 s). Her QP weighs the MPC's forces at 1000
-    (``wbc_force_weight``): at 100 the posture task bent her pushes on the shoes and she
-    drifted back at up to 0.17 m/s within 2 s. The shoes do not ring under her toes: with
+    QP's forces and she fell within 0.8 s). Her QP weighs the MPC's forces at 1000 (the
+    pair file's ``wbc.force_weight``): at 100 the posture task bent her pushes on the shoes
+    and she drifted back at up to 0.17 m/s within 2 s. The shoes do not ring under her toes: with
     the MPC's forces low-passed (``ForceFilter``) the platforms' pitch wavers by 0.0041 and
     0.0037 rad (left, right; standard deviation after 0.5 s; 0.0039 and 0.0034 with each plan
     taking over in the tick it was solved, ``plan_latency=0``), unfiltered by 0.0086 rad, at
@@ -439,10 +440,10 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd() -> None:
     she stands: with the pair's terminal factor (30) her plans bring her back to the
     reference, at 10 they let her roll back at 0.05 m/s."""
     cassie = load_robot("cassie")
-    assert cassie.params.tracking_gain_scale == pytest.approx(0.1)
     rider = MpcRider(cassie, "hovershoes")
+    assert rider.pair.description.wbc.tracking_gain_scale == pytest.approx(0.1)
     np.testing.assert_allclose(rider.kp, 0.1 * np.array([m.kp for m in cassie.motors]))
-    assert rider.wbc.settings.force_weight == pytest.approx(cassie.params.wbc_force_weight)
+    assert rider.wbc.settings.force_weight == pytest.approx(1000.0)
     assert rider.wbc.settings.pyramid == rider.pair.pyramid == "diamond"
     assert rider.mpc.terminal_factor == rider.pair.terminal_factor == pytest.approx(30.0)
     # each shoe's heading read off its direction of travel too (the soles creep round)

@@ -9,7 +9,7 @@ import pytest
 from ridempc.errors import ConfigError
 from ridempc.mpc.manoeuvre import REPUSH, REPUSH_BAND, Manoeuvre, ManoeuvreSelector
 from ridempc.scenarios.scenario import Command
-from ridempc.trajopt.pairs import EntrySpec
+from ridempc.trajopt.pairs import EntrySpec, load_pair
 from ridempc.trajopt.schedule import push_schedule
 from ridempc.trajopt.skate_pair import REPUSH_GAIN, repush_entry, skate_models
 from ridempc.trajopt.skate_problem import initial_skate_state
@@ -25,7 +25,7 @@ def test_a_rolling_start_needs_the_strides_of_the_speed_it_gains() -> None:
 
 
 def test_the_rolling_start_state_rides_with_the_board() -> None:
-    robot, board = skate_models()
+    robot, board = skate_models("cyberdog2", "skateboard")
     rest, places = initial_skate_state(robot, board)
     rolling, same_places = initial_skate_state(robot, board, 0.5)
     nr = 12 + robot.n_joints
@@ -38,7 +38,7 @@ def test_the_rolling_start_state_rides_with_the_board() -> None:
 def test_a_repush_problem_starts_rolling_and_ends_at_its_target() -> None:
     """Built, not solved (IPOPT takes 40 s): node 0 fixed at the rolling start, the last
     node's speed at the target, the speed reference ramped from the one to the other."""
-    from ridempc.trajopt.skate_pair import PAIR
+    PAIR = load_pair("cyberdog2", "skateboard")
 
     spec = repush_entry(0.7)
     assert spec.name == "repush-0.70" and spec.options["start_speed"] == pytest.approx(0.5)
@@ -128,7 +128,7 @@ def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push
 def test_the_committed_library_holds_the_repush_entries_its_pair_builds() -> None:
     """``ridempc library build`` makes the re-pushes whose rolling start is no slower than
     the least target, and the committed library holds them (the rider reads them)."""
-    from ridempc.trajopt.skate_pair import PAIR
+    PAIR = load_pair("cyberdog2", "skateboard")
 
     names = [s.name for s in PAIR.entries(PAIR.default_targets)]
     assert [n for n in names if n.startswith(REPUSH)] == [

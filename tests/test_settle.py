@@ -12,10 +12,16 @@ import pytest
 
 from ridempc.errors import ConfigError
 from ridempc.mpc.controller import LinearMpc
-from ridempc.mpc.pairs import SETTLE_TIME
+from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.settle import settle_over_feet
+from ridempc.pair_description import load_pair_description
 from ridempc.trajopt.rigid_body import feet_world
 from ridempc.trajopt.skate_pair import skate_models
+
+# [s] the skateboard pair's settle over its feet (its pair file's ``stages.settle``)
+_settle = load_pair_description("cyberdog2", "skateboard").stages.settle
+assert _settle is not None
+SETTLE_TIME = _settle.duration
 
 
 def _on_board(reference, states: np.ndarray) -> np.ndarray:
@@ -47,7 +53,7 @@ def test_nothing_changes_before_the_end(settled) -> None:
 
 def test_the_centre_of_mass_goes_back_over_the_feet(settled) -> None:
     reference, held = settled
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     end = reference.times[-1]
     times = np.array([end, end + 0.5 * SETTLE_TIME, end + SETTLE_TIME, end + 3.0])
     states, still = reference.states_at(times), held.states_at(times)
@@ -81,19 +87,19 @@ def test_the_forces_are_shared_as_at_the_start(settled) -> None:
 def test_a_reference_without_one_board_cannot_settle() -> None:
     shoes = LinearMpc.from_library("cassie", "hovershoes", "accelerate", 1.0).reference
     assert shoes.settle_states is None  # the Hovershoes do not settle
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     with pytest.raises(ConfigError, match="settle"):
-        settle_over_feet(shoes, robot, 1.0)
+        settle_over_feet(shoes, robot, 1.0, load_mpc_pair("cassie", "hovershoes").board_states)
 
 
 def test_a_settle_the_legs_cannot_reach_is_refused(settled) -> None:
     """A reference whose start stood a metre further back on the board: no joint angles
     keep the feet where they ended, and the error says so in one line."""
     reference, _ = settled
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     states = reference.states.copy()
     states[0, reference.state_names.index("com_x")] -= 1.0
     far = replace(reference, states=states, settle_states=None, settle_inputs=None)
     with pytest.raises(ConfigError, match="no joint angles keep the feet in place") as info:
-        settle_over_feet(far, robot, 1.0)
+        settle_over_feet(far, robot, 1.0, load_mpc_pair("cyberdog2", "skateboard").board_states)
     assert "\n" not in str(info.value)

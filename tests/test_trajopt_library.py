@@ -105,7 +105,7 @@ def test_the_rider_keeps_its_riding_height(pair_name: str) -> None:
 
 def _skate_entries() -> Iterator[tuple[Any, Any, dict[Contact, np.ndarray]]]:
     """Each committed skateboard entry with its stored options and its schedule's masks."""
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     _, entries = load_library(library_folder("cyberdog2", "skateboard"))
     for entry in entries:
         options = skate_options(entry.record.metadata["options"])
@@ -118,7 +118,7 @@ def test_the_dog_keeps_its_centre_of_mass_inside_the_feet_on_the_deck() -> None:
     feet on the deck, measured here from the stored states with NumPy (the NLP imposes it in
     CasADi). Before the margin the entries left it on the triangle's diagonal when the
     pushing foot landed, and riders whose trunk tipped a little early fell."""
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     nr = 12 + robot.n_joints
     for entry, options, masks in _skate_entries():
         assert options.support_margin >= 0.01, entry.record.name
@@ -145,7 +145,7 @@ def test_the_pushing_foot_lands_nearly_still() -> None:
     """In the grid step before it lands on the ground the pushing foot of every skateboard
     entry covers at most ``touchdown_step`` along each horizontal axis (without it, the
     1.0 m/s entry's foot reached the ground at the trunk's 1.1 m/s)."""
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     nr = 12 + robot.n_joints
     for entry, options, masks in _skate_entries():
         pusher = robot.feet.index(options.pusher)
@@ -167,7 +167,7 @@ def test_the_pushing_foot_lifts_unloaded() -> None:
     """In the grid step before it lifts off the ground the pushing foot of every skateboard
     entry carries at most ``liftoff_force`` weights per foot (without it, the 1.0 m/s entry's
     last push ended at 51 N, and push-off-1.0 seed 18 fell after it)."""
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     weight_per_foot = robot.mass * GRAVITY / robot.n_feet
     for entry, options, masks in _skate_entries():
         pusher = robot.feet.index(options.pusher)
@@ -186,7 +186,7 @@ def test_the_stance_legs_stay_under_the_motor_curves() -> None:
     """Every skateboard entry's stance-leg statics torques stay within ``torque_fraction`` of
     the motors' torque-speed curves at the entry's planned joint rates (the NLP's rows,
     measured here with NumPy): the curves hold for the committed entries."""
-    robot, _ = skate_models()
+    robot, _ = skate_models("cyberdog2", "skateboard")
     nf, nr = robot.n_feet, 12 + robot.n_joints
     q = ca.SX.sym("q", robot.n_joints)
     jacobians = ca.Function("jacobians", [q], [robot.foot_jacobian(q, i) for i in range(nf)])

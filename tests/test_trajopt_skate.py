@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from ridempc.errors import ConfigError, UnknownNameError
+from ridempc.pair_description import load_pair_description
 from ridempc.trajopt.pairs import EntrySpec, load_pair
 from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skate_pair import skate_models, skate_options
@@ -27,7 +28,7 @@ def test_unknown_pair_and_option_are_refused() -> None:
 
 
 def test_initial_state_stands_on_the_deck() -> None:
-    robot, board = skate_models()
+    robot, board = skate_models("cyberdog2", "skateboard")
     state, on_deck = initial_skate_state(robot, board)
     assert np.allclose(on_deck[:, 2], robot.foot_radius, atol=5e-3)  # feet on the deck top
     assert np.all(np.abs(on_deck[:, 1]) < board.half_width)  # and inside its width
@@ -38,7 +39,7 @@ def test_initial_state_stands_on_the_deck() -> None:
 def test_problem_structure_and_bounds() -> None:
     pair = load_pair("cyberdog2", "skateboard")
     problem = pair.build(EntrySpec("accelerate", 0.3))
-    robot, board = skate_models()
+    robot, board = skate_models("cyberdog2", "skateboard")
     n, nx, nu = problem.n_intervals, problem.nx, problem.nu
     assert (nx, nu) == (30, 24)
     assert problem.variables.shape[0] == n * (2 * nx + nu) + nx
@@ -48,7 +49,8 @@ def test_problem_structure_and_bounds() -> None:
     x0, _ = initial_skate_state(robot, board)
     assert np.allclose(problem.lbw[:nx], x0) and np.allclose(problem.ubw[:nx], x0)
     # The pushing foot carries no force while it swings; joint speeds within 31 rad/s.
-    masks = skate_schedule(robot, 0.3, skate_options({})).contact_masks()
+    defaults = load_pair_description("cyberdog2", "skateboard").trajopt.problem_options()
+    masks = skate_schedule(robot, 0.3, skate_options({}, defaults)).contact_masks()
     stride = 2 * nx + nu
     upper = problem.ubw[: n * stride].reshape(n, stride)[:, nx : nx + nu] * problem.input_scale
     pusher = robot.feet.index("RL_contact")

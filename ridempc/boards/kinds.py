@@ -33,12 +33,18 @@ class BoardKind(NamedTuple):
             with the board resting on the ground at the world origin.
         firmware: Makes the board's firmware from its parameters and I/O.
         identify: Identifies the kind's reduced model from simulated experiments on a board.
+        features: What the rider meets on this kind of board, by name: ``shoes`` (one
+            self-balancing platform per foot, tipping over its wheel's tread), ``knee_bar``
+            (a bar the legs push to turn), ``deck_roll`` (a deck that rolls on its trucks
+            and steers by its roll). A pair file's stages name the features they need
+            (:mod:`ridempc.pair_description`).
     """
 
     parameters: type[BoardParameters]
     build: Callable[[BoardParameters], mujoco.MjSpec]
     firmware: Callable[[BoardParameters, BoardIO], Firmware]
     identify: Callable[[Board], IdentificationResult]
+    features: frozenset[str] = frozenset()
 
 
 BOARD_KINDS: dict[str, str] = {

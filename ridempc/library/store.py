@@ -82,8 +82,19 @@ class LibraryEntry:
 
 
 def library_folder(robot: str, board: str, root: Path | None = None) -> Path:
-    """``<root>/<robot>-<board>`` (root: the repository's ``motion_library/``)."""
-    return (root or motion_library_dir()) / f"{robot}-{board}"
+    """``<root>/<library>`` (root: the repository's ``motion_library/``), the library the
+    pair file names (:mod:`ridempc.pair_description`), ``<robot>-<board>`` for a pair
+    without one.
+
+    Raises:
+        ConfigError: The pair's file is malformed or does not fit its robot and board.
+    """
+    from ridempc.pair_description import load_pair_description, pair_description_names
+
+    name = f"{robot}-{board}"
+    if name in pair_description_names():
+        name = load_pair_description(robot, board).library
+    return (root or motion_library_dir()) / name
 
 
 def entry_bytes(arrays: dict[str, NDArray[Any]]) -> bytes:

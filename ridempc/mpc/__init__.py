@@ -12,7 +12,7 @@ sparse QP built once and updated in place, OSQP), :mod:`.plan` (what a solve ret
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.discretisation import zero_order_hold
 from ridempc.mpc.friction import force_bounds, friction_pyramids, pyramid_pattern
-from ridempc.mpc.pairs import MPC_PAIRS, MpcPair, load_mpc_pair, surface_rotations
+from ridempc.mpc.pairs import MpcPair, load_mpc_pair, mpc_pair_names, surface_rotations
 from ridempc.mpc.plan import Plan, shift_plan
 from ridempc.mpc.problem import (
     MPC_STEP,
@@ -33,7 +33,6 @@ from ridempc.mpc.reference import (
 from ridempc.mpc.weights import bryson_weights
 
 __all__ = [
-    "MPC_PAIRS",
     "MPC_STEP",
     "LinearMpc",
     "LinearModel",
@@ -53,6 +52,7 @@ __all__ = [
     "friction_pyramids",
     "linearize",
     "load_mpc_pair",
+    "mpc_pair_names",
     "pyramid_pattern",
     "reference_from_entry",
     "select_reference",

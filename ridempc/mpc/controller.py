@@ -25,9 +25,9 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.canonical import board_state_columns
 from ridempc.errors import ConfigError
 from ridempc.mpc.friction import force_bounds, friction_pyramids, pyramid_pattern
-from ridempc.mpc.manoeuvre import YAW_RATE_SUFFIXES
 from ridempc.mpc.pairs import MpcPair, load_mpc_pair, surface_rotations
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MPC_STEP, LinearModel, MpcProblem, build_linear_model, linearize
@@ -125,6 +125,8 @@ class LinearMpc:
             reference.input_names,
             pair.weight / len(pair.contacts),
             self.settings.weights,
+            base=pair.base,
+            board_states=pair.board_states,
         )
         self._fixed = self._fixed_indices(self.settings.fixed_inputs)
         self.structure = QPStructure(
@@ -159,13 +161,14 @@ class LinearMpc:
         self._fixed = self._fixed_indices(fixed)
         self.settings = replace(self.settings, fixed_inputs=fixed)
 
-    def steers(self, patterns: tuple[str, ...] = YAW_RATE_SUFFIXES) -> bool:
+    def steers(self) -> bool:
         """Whether an input that is not held drives a board's yaw rate directly
-        (:math:`\\partial \\dot x / \\partial u \\ne 0` at the reference's start on a state
-        named ``*_psi_dot`` or ``*_yaw_rate``): a Hovershoe turns under the feet's yaw
-        torque, a Segway only by its knee bar, which a pinned bar cannot."""
-        names = self.reference.state_names
-        rows = [i for i, n in enumerate(names) if n.endswith(patterns)]
+        (:math:`\\partial \\dot x / \\partial u \\ne 0` at the reference's start on a board
+        state whose quantity is ``yaw_rate``, :attr:`~ridempc.mpc.pairs.MpcPair.
+        board_states`): a Hovershoe turns under the feet's yaw torque, a Segway only by its
+        knee bar, which a pinned bar cannot."""
+        columns = board_state_columns(self.reference.state_names, self.pair.board_states)
+        rows = [i for state, i in columns.items() if state.quantity == "yaw_rate"]
         free = [
             i
             for i, n in enumerate(self.reference.input_names)

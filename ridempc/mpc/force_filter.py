@@ -1,13 +1,9 @@
 """The MPC's forces low-passed from one solve to the next, before the whole-body QP gets them.
 
-On the Hovershoes the MPC's first input jumped by about 20 N per contact from one 30 Hz solve
-to the next (standard deviation over 10-14 s of the circle, seed 1, against 80 N of load):
-each solve answers a new estimate of the shoes' pitch and pitch rate, whose one-step
-prediction it got poorly (correlation 0.41 between the predicted and the next estimated
-pitch). The whole-body QP passed the steps on to the toes, and the toes and the shoes'
-pitch loops rang at 7-9 Hz: platform pitch standard deviation 0.007 rad at stand-still
-against the ``pd`` baseline's 0.0012, shoe speed 0.07 m/s against 0.014, toe torque
-1.3 N m against 0.44.
+On the Hovershoes the MPC's first input jumps from one 30 Hz solve to the next: each solve
+answers a new estimate of the shoes' pitch and pitch rate, whose one-step prediction is poor.
+Passed on to the toes by the whole-body QP, the steps make the toes and the shoes' pitch
+loops ring at 7-9 Hz (measurements: ``docs/tuning.md``).
 
 The forces the whole-body QP is given, :math:`\\bar u`, follow the plan's first input
 :math:`u_0` through a first-order low-pass with time constant :math:`\\tau` [s]:
@@ -18,9 +14,7 @@ The forces the whole-body QP is given, :math:`\\bar u`, follow the plan's first 
     \\alpha = 1 - e^{-\\Delta t / \\tau}
 
 with :math:`\\Delta t` [s] the time since the last solve (0.03 s at the rider's 33.3 Hz).
-The first solve passes through. Measured at stand-still (seed 0, 8 s), with
-:math:`\\alpha` = 0.5 and 0.3 per solve (:math:`\\tau` = 0.043 and 0.084 s): platform pitch
-standard deviation 0.0073 -> 0.0035 and 0.0025 rad, toe torque 1.31 -> 0.51 and 0.41 N m.
+The first solve passes through.
 
 The filter is for pairs whose feet do not swing (the Hovershoes): it would hold a force on
 a foot the schedule lifts.

@@ -2,10 +2,9 @@
 
 A shoe rolls only along its heading, so the MPC moves it sideways only by turning it, and
 over its 0.4 s horizon a heading held to within 0.05 rad cannot move it far: the shoes'
-sideways drift went uncorrected. In turns the feet drifted from their 0.41 m spacing to
-0.28 m and 0.54 m, and the rider fell doing the splits (foot-spacing RMSE 0.099 m against
-the ``pd`` baseline's 0.029 m, whose hip-yaw loop turns a foot that is too far out inwards,
-hovershoe paper eq. 14-15).
+sideways drift goes uncorrected, and in turns the rider ends in the splits (the ``pd``
+baseline's hip-yaw loop turns a foot that is too far out inwards, hovershoe paper eq.
+14-15).
 
 Here each shoe's heading reference is turned towards its line, as in pure pursuit:
 
@@ -19,15 +18,8 @@ horizon's first node [m], :math:`n` the normal to the reference heading (to the 
 :math:`v^*` the reference speed [m/s] and :math:`\\tau` = ``TAU`` [s]: at speed :math:`v^*`
 the heading :math:`\\Delta\\psi` closes the error at :math:`e / \\tau`. The turn is added to
 the shoe's heading over the whole horizon; below ``MIN_SPEED`` nothing is turned (the law
-would ask for large angles a shoe at rest cannot use).
-
-Measured (seed 0 unless stated, Hovershoes yaw-steps, 0.5 rad/s for 10 s at 0.5 m/s):
-
-- :math:`\\tau` = 1 s: seeds 1 and 2 rode through (yaw-rate RMSE 0.068 and 0.064 rad/s,
-  spacing RMSE 0.029 m), seed 0 fell at 11.4 s;
-- 2 s: seed 1 through, seeds 0 and 2 fell (10.5 s, 20.9 s);
-- 0.7 s: seeds 0, 1 and 2 rode through (yaw-rate RMSE 0.062, 0.070, 0.063 rad/s; the
-  ``pd`` baseline's 0.113 on seed 0); without the law they fell at 17.3, 24.3, 15.3 s.
+would ask for large angles a shoe at rest cannot use). ``TAU`` is the shortest tried that
+rode the yaw steps through (``docs/tuning.md``).
 """
 
 from __future__ import annotations

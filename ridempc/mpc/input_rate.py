@@ -2,15 +2,9 @@
 
 The whole-body QP realises the plan's first input :math:`u_0` until the next solve, and
 the MPC, whose state weights are tight and whose deck roll is a fast mode it can move in
-one step, answers each new estimate with a new :math:`u_0`: on the skateboard, after the
-last push of push-off-1.0 (seed 0, the pushing foot swinging back to the deck), the deck
-forces of the three standing feet jumped by 25 N RMS from one solve to the next (110 N on
-the front-left foot and the floor's 8.7 N on the front-right, then the other way round,
-against 30-40 N of load). The front-right foot, left at the floor, lost the deck, slid
-7 cm inwards and came down there: the ride went on with the feet 2 cm to the left of the
-deck's centre line, which the estimate (the feet's centroid) cannot see, and when the deck
-was rolled to the right the left feet, carrying all the weight they could, lifted off and
-the ride fell at 9.3 s (see :mod:`ridempc.mpc.roll_observer`).
+one step, answers each new estimate with a new :math:`u_0`: on the skateboard, while a foot
+swings back to the deck, the three standing feet's deck forces swap between solves, and a
+foot left at the floor's least force can lose the deck (``docs/tuning.md``).
 
 With :math:`u_p` the last plan's first input, a penalty :math:`\\|u_0 - u_p\\|^2_S` on top of
 the MPC's :math:`\\|u_0 - \\bar u_0\\|^2_R` (eq. 19, drawn to the reference :math:`\\bar u`)

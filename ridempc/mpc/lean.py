@@ -39,49 +39,33 @@ gives, so the rider holds that input at zero and leans instead, as the ``pd`` ba
 
    - the rider's and the board's headings and yaw rates in the reference turn at the
      commanded rate :math:`\\omega^*`, :math:`\\psi_k \\mathrel{+}= \\omega^* k \\Delta t`,
-     :math:`\\omega_{z,k} \\mathrel{+}= \\omega^*`: held at zero yaw rate, the plan braked
-     the rider's yaw while the board turned under her, and her pelvis followed the board
-     0.2-0.3 s late (in a prototype that laid on the measured yaw rate instead, the
-     rider's yaw fed itself and she fell at 7.75 s);
+     :math:`\\omega_{z,k} \\mathrel{+}= \\omega^*`: held at zero yaw rate, the plan would
+     brake the rider's yaw while the board turns under her (the measured yaw rate, laid
+     on instead, feeds itself);
    - the heading the library frame follows (the board's direction of travel, low-passed
      over 0.3 s) is carried by the same commanded rate
      (:meth:`~ridempc.mpc.state_map.StateMap.follow_sideways`): low-passed alone, it
-     lagged a steady turn by 0.15 rad at 0.5 rad/s, and the MPC held the pelvis and the
-     centre of mass's velocity outside the turn;
+     lags a steady turn, and the MPC would hold the pelvis outside it;
    - the frame that follows the board turns with it at :math:`\\hat\\omega`, which the
      MPC's model does not know: in it the centre of mass feels the centrifugal
      acceleration :math:`-v \\hat\\omega` across the heading (:math:`v` the board's
      speed [m/s]), added to the rates of :math:`\\dot y` as a drift (0.5 m/s² at 1 m/s and
      0.5 rad/s, which the rider meets by leaning into the turn).
 
-   Before, the reference sat at :math:`g s` with :math:`g = 8`, the heading followed with a
-   lag of :math:`\\omega T` and neither the turn nor its centrifugal pull was in the plan:
-   the MPC's tolerances (0.05 m on :math:`y`, 0.05 m/s on :math:`\\dot y`) let the centre
-   of mass approach a fixed offset over about a second, and it settled at an eighth of it.
-   Yaw-steps (1 m/s, 0.5 rad/s for 10 s) overshot the step to 1.1 rad/s and rang for 3 s
-   after each step: yaw-rate RMSE 0.170/0.184/0.175 rad/s on seeds 0/1/2 (the ``pd``
-   baseline's 0.117/0.118/0.117); as built, 0.061/0.060/0.061. Seed 0, one change at a
-   time from it: without the path (the lean at every node), 0.072; without the turned yaw
-   references, 0.092; without the turn carrying the followed heading, 0.106; without the
-   centrifugal drift, 0.064 (the circle at 2 m/s and 0.5 rad/s: 0.028 -> 0.034). The
-   board itself (its yaw rate averaged over 0.1 s) tracks with 0.109 rad/s (the ``pd``
-   rider's 0.120, before 0.196): its steering still waits the 0.3 s the lean takes to
-   push the bar, and the rider's pelvis, turned with the command, leads it, up to 0.13
-   rad off the board at a step (the ``pd`` rider's 0.05).
+   Each of the four (the path, the turned yaw references, the turn carried by the
+   followed heading, the centrifugal drift) takes its share of the yaw-rate error off
+   (``docs/tuning.md``); the board's steering still waits the 0.3 s the lean takes to
+   push the bar.
 
    *Standing* (slower), the loop holds the yaw rate at zero, whatever the command, and the
-   reference sits at ``STANDING_PULL`` :math:`\\times s` over the whole horizon, as before:
+   reference sits at ``STANDING_PULL`` :math:`\\times s` over the whole horizon:
    the pad pushes back on the shins with a force that neither the MPC nor the whole-body
    QP models, and each MPC tick plans from where that force has left the rider, so the
-   centre of mass settles at a fraction of its reference's offset (8 was found on the
-   circle, where riding used it too: yaw-rate RMSE 0.429, 0.304, 0.195, 0.087 and 0.057
-   rad/s at 1, 2.5, 4, 6 and 8; the offset-start's rider, feet 1 cm to the left, pushes
-   the bar with a shin: with riding's path and unit pull she let it reach 0.04 rad and
-   fell at 5.8 s). Standing still the frame keeps its heading, the plan holds the rider's
-   yaw against the turning platform, the loop winds up, and following a 0.5 rad/s command
-   the bar was pushed to 0.26 rad: the Segway spun at 1.5 rad/s and Cassie fell 2 s later
-   (turning in place is left undone). Without the loop at all, the offset-start's
-   crouched rider pushed the bar unchecked and fell.
+   centre of mass settles at a fraction of its reference's offset, which
+   ``STANDING_PULL`` makes up for (found on the circle). Standing still the frame keeps its
+   heading and the plan would hold the rider's yaw against a turning platform, so the loop
+   does not turn in place (left undone); without the loop at all a crouched rider's shin
+   pushes the bar unchecked.
 """
 
 from __future__ import annotations
@@ -122,8 +106,7 @@ LEAN_GAINS = LoopGains(
     ki=0.1,  # [m per rad]
     integral_limit=0.08,  # [m]
     max_shift=0.1,  # [m]
-    # [m/s] twice the pd rider's: riding, the path takes the centre of mass there (yaw-steps
-    # seed 0 with the heading carried by the gyro, yaw-rate RMSE 0.104 at 0.1, 0.082 at 0.2)
+    # [m/s] twice the pd rider's: riding, the path takes the centre of mass there
     max_rate=0.2,
     filter_hz=5.0,  # [Hz] on the yaw rate
 )

@@ -150,6 +150,20 @@ class StateLayout:
             raise ConfigError(f"cannot tell the base's roll among the states {names}")
         return cls(prefixes, bases[0], {n: i for i, n in enumerate(names)})
 
+    @classmethod
+    def from_pair(
+        cls, state_names: Sequence[str], prefixes: Sequence[str], base: str
+    ) -> StateLayout:
+        """The layout a pair declares: its platforms' prefixes (``MpcPair.platform_prefixes``)
+        and its robot's base body (``MpcPair.base``, whose angles are ``<base>_roll`` ...).
+
+        Raises ConfigError: the names have no ``<base>_roll`` or no ``<prefix>x``."""
+        names = list(state_names)
+        missing = [n for n in (f"{base}_roll", *(f"{p}x" for p in prefixes)) if n not in names]
+        if missing:
+            raise ConfigError(f"no state '{missing[0]}' among the states {names}")
+        return cls(tuple(prefixes), f"{base}_", {n: i for i, n in enumerate(names)})
+
     @property
     def rider_states(self) -> tuple[int, ...]:
         """Indices of the states that are not a platform's (the rider's)."""

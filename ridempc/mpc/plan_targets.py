@@ -10,8 +10,8 @@ solved in into the world by that frame's yaw :math:`\\Delta\\psi` and offset
 - the base orientation :math:`R = R_z(\\psi + \\Delta\\psi) R_y(\\vartheta) R_x(\\phi)` from the
   plan's Z-Y-X angles (Pinocchio's ``rpyToMatrix``), as a (w, x, y, z) quaternion with
   :math:`w \\ge 0`, and the base angular velocity :math:`R\\,\\omega_B` [rad/s];
-- where the robot feeds them forward (``wbc_feedforward``, a share), the first step's
-  accelerations :math:`(v_1 - v_0)/\\Delta t` [m/s^2] and
+- where the pair feeds them forward (its pair file's ``wbc.feedforward``, a share), the
+  first step's accelerations :math:`(v_1 - v_0)/\\Delta t` [m/s^2] and
   :math:`R (\\omega_1 - \\omega_0)/\\Delta t` [rad/s^2];
 - the first input's contact forces [N], per library contact and summed per foot.
 

@@ -6,27 +6,19 @@ goes on at is set while the foot is down and while the rider settles on the deck
 it. Bryson's weights
 (:mod:`ridempc.mpc.weights`) keep the CoM's speed :math:`v_x` within 0.05 m/s and the
 board's :math:`v_B` within 0.1 m/s, loosely, so that balance comes first; over a push
-that let each ride's plans take up their own shortfall in the CoM's position instead,
-and the dog's push-off-0.3 ended 0.267 to 0.332 m/s on seeds 0-3 (-11 % to +11 %).
+that lets each ride's plans take up their own shortfall in the CoM's position instead,
+and the push-offs end off their targets by up to about a tenth (``docs/tuning.md``).
 
 So while the ride tracks an entry whose schedule puts a foot on the ground, from the
 entry's start to its end, the stage and terminal weights of the states named in the pair's
 ``push_tolerances`` become :math:`1/\\sigma^2` of those tolerances (:math:`Q_N` = the
 pair's terminal factor times :math:`Q`, as always); the rest of the ride keeps its
 weights. The board's speed is judged over the entry's last 0.25 s and the next 0.25 s,
-after the last stroke, so the weights hold to the entry's end (held only while a stroke
-was in the horizon, or only from the last stroke on, push-off-0.3 seed 2 ended at
-0.322 m/s either way, against 0.318).
+after the last stroke, so the weights hold to the entry's end.
 
 They hold up to the pair's ``push_max_target``: on the skateboard 0.7 m/s, the entries of
-one to three strokes. With the libraries built before the support margin and the still
-touchdown (:class:`~ridempc.trajopt.skate_problem.SkateOptions`) they held only to 0.5:
-with them the dog sank onto the deck in the roll phase after push-off-0.7 (seeds 1 and 2,
-at 7.7-7.9 s). With today's libraries push-off-0.7 seeds 14 and 5 ended at 0.662 and
-0.660 m/s with them against 0.630 and 0.639 without (the target's 10 % is 0.63), and all
-of seeds 0-15 ride. The four-stroke push-off to 1.0 m/s, whose last stroke lasts 0.25 s
-with the pushing hip at its torque limit, still falls with them (seeds 4 and 14 at 5.7-5.9
-s, in that stroke), as it did over the whole ride.
+one to three strokes; the four-stroke push-off to 1.0 m/s, whose last stroke lasts 0.25 s
+with the pushing hip at its torque limit, falls in that stroke with them.
 """
 
 from __future__ import annotations
@@ -49,7 +41,7 @@ def pushing(reference: MotionReference, t: float, max_target: float = math.inf) 
     foot on the ground (a push-off) and its target is at most ``max_target`` [m/s].
 
     Before a push-off is commanded the rider holds the start of the lowest entry, at a
-    negative reference time: not a push (with the weights there, push-off-1.0 seed 1 fell).
+    negative reference time: not a push (the rider stands, the weights would fight it).
     """
     if reference.target > max_target or not 0.0 <= t < float(reference.times[-1]):
         return False  # before its start (the rider at rest, waiting) or after its end

@@ -41,7 +41,7 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.input_rate`);
 3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
    over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
-   the Z-Y-X angles, where the robot asks for it (``wbc_feedforward``) the plan's
+   the Z-Y-X angles, where the pair asks for it (``wbc.feedforward``) the plan's
    first-step accelerations :math:`(v_1 - v_0)/\\Delta t` and
    :math:`(\\omega_1 - \\omega_0)/\\Delta t` fed forward, the first input's contact forces
    (summed per foot; on the Hovershoes low-passed from solve to solve,
@@ -51,14 +51,14 @@ Every 2 ms (500 Hz) the rider
    (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
    (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the reference's
    joint angles where the library has them, the dog's, else the robot's riding posture
-   on the board, its stance unless a riding keyframe is given: held at the stance, the
-   dog's trunk stayed 3-4 cm above the reference's crouch before a push). A foot the
+   on the board, its stance unless a riding keyframe is given: the stance would hold the
+   dog's trunk above the reference's crouch). A foot the
    schedule puts on the ground (a push-off) stands on the ground for the WBC and the
    estimator, not on the board; a foot it lifts is left out of the board's estimate even
    if it touches something;
 4. sends the QP's torques as feedforward, each led over its motor's torque delay
    (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD, at the
-   robot's ``tracking_gain_scale`` of its default stiffnesses; a delayed motor's damping is
+   pair's ``tracking_gain_scale`` of its default stiffnesses; a delayed motor's damping is
    the one of largest phase margin for that stiffness at the joint's inertia in the riding
    posture (:func:`~ridempc.robots.delay_margin.tracking_damping`), the others' the same
    scale of their default damping.
@@ -77,14 +77,14 @@ import time
 from concurrent.futures import Future
 from dataclasses import replace
 from functools import cache
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState, board_state_columns
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
-from ridempc.boards.skateboard.parameters import SkateboardParameters
 from ridempc.boards.skateboard.reduced import yaw_rate
 from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
@@ -99,12 +99,11 @@ from ridempc.mpc.manoeuvre import (
     HEADING_SUFFIXES,
     HOLD,
     REPUSH,
-    YAW_RATE_SUFFIXES,
     Manoeuvre,
     ManoeuvreSelector,
     StateLayout,
 )
-from ridempc.mpc.pairs import load_mpc_pair
+from ridempc.mpc.pairs import check_library_names, load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
@@ -140,11 +139,6 @@ __all__ = ["MpcRider", "platform_feet", "rolling_platforms"]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
-# Board inputs of the library that this rider does not realise, held at zero in the MPC: the
-# Segway's knee bar (the legs' push on the pad is not in the model; planning turns with a bar
-# nobody pushes let the yaw run off: stand-still fell at 1.5 s, pinned it stands). The rider
-# leans into the bar instead (ridempc.mpc.lean).
-UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
 WBC_GRACE_TICKS: int = 5
@@ -184,15 +178,14 @@ def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
     """The platforms that the rider's push moves, as the WBC sees them: each Hovershoe, the
     bare shoe with its identified drive (:mod:`ridempc.wbc.platforms`); the skateboard's deck,
     its translating mass with no drive (3.2 kg under a 9 kg dog: taken for ground, the deck
-    feet pushed it 0.24 m/s past its plan as the pusher returned, and push-off-0.7 fell at
-    2.55 s instead of 3.41 s); none otherwise."""
-    if board is not None and isinstance(board.params, SkateboardParameters):
+    feet would push it past its plan as the pusher returns); none otherwise."""
+    features = board.kind.features if board is not None else frozenset()
+    if board is not None and "deck_roll" in features:
         return (RollingPlatform(mass=skateboard_model(board).mass, drive=0.0),)
-    if board is None or not isinstance(board.params, HovershoesParameters):
+    if board is None or "shoes" not in features:
         return ()
-    shoes = wheeled_board(board)
-    assert isinstance(shoes, HovershoesBoard)
-    params = board.params
+    shoes = cast(HovershoesBoard, wheeled_board(board))
+    params = cast(HovershoesParameters, board.params)
     shoe = RollingPlatform(
         mass=shoes.shoe_mass,
         drive=shoes.reduced.c4,
@@ -237,6 +230,8 @@ class MpcRider(Controller):
         from ridempc.boards import load_board
 
         self.pair = load_mpc_pair(robot.name, board)
+        stages = self.pair.description.stages  # the pair file's per-pair mechanisms
+        tuning = self.pair.description.wbc
         # Ticks from the state a solve starts from to the tick its plan takes over: with 1
         # or more OSQP iterates in a thread beside the loop and the ticks between follow
         # the previous plan; waited for at that tick, so that a ride does not depend on the
@@ -260,40 +255,43 @@ class MpcRider(Controller):
             robot.name, board, first.library_kind, first.target, settings
         )
         names = self.mpc.reference.input_names
-        pinned = {n: 0.0 for n in UNREALISED_INPUTS if n in names}
+        check_library_names(self.pair.description, self.mpc.reference)
+        # Board inputs of the library that this rider does not realise (the pair file's
+        # ``unrealised_inputs``), held at zero in the MPC.
+        unrealised = self.pair.description.mpc.unrealised_inputs
+        pinned = {n: 0.0 for n in unrealised if n in names}
         self.mpc.fix_inputs({**pinned, **self.mpc.settings.fixed_inputs})
         # Yaw-rate commands are laid over the reference only where the rider can turn the
-        # board (not the Segway with its knee bar pinned: it rode yaw-steps straight, and
-        # with the turn laid over it fell at 7.7 s).
+        # board (not the Segway with its knee bar pinned, which the lean turns).
         self.steers = self.mpc.steers()
         # A board with a yaw rate that the rider cannot drive (the Segway's): the library
         # frame turns with its heading (StateMap.follow_sideways).
-        yaw_rates = any(n.endswith(YAW_RATE_SUFFIXES) for n in self.mpc.reference.state_names)
+        # where each board state is in the MPC's state, by its canonical quantity
+        columns = board_state_columns(self.mpc.reference.state_names, self.pair.board_states)
+        yaw_rates = any(state.quantity == "yaw_rate" for state in columns)
         self._follows_heading = yaw_rates and not self.steers
         # A board turned by a bar the legs push (the Segway's knee bar, held at zero in the
         # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
         self.crouch = Crouch.of(robot, board)
-        self.lean = LeanSteering() if "knee_bar" in pinned and not self.steers else None
+        self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
-        self.layout = StateLayout.from_names(reference.state_names)
-        self.map = StateMap(self.pinocchio, reference.state_names, self.layout.prefixes)
+        self.layout = StateLayout.from_pair(
+            reference.state_names, self.pair.platform_prefixes, self.pair.base
+        )
+        self.map = StateMap(
+            self.pinocchio, reference.state_names, self.layout.prefixes, base=self.pair.base
+        )
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
         # achilles-rod constraint) drives the QP off (see the WBC's tests).
-        # The MPC's forces weigh ``wbc_force_weight`` (100 by default, 100x the WBC's own
-        # default): their distribution over the feet is what rolls a deck or a platform, and
-        # the CoM and orientation tasks leave it free (the dog's roll-tracking: roll RMSE
-        # 0.063 rad at 1, 0.048 at 100). The dog's is 800: at 100 its WBC unloaded the
-        # three-leg stance's light foot that the MPC keeps at 0.4 of its share, and the
-        # foot lifted off the deck (push-offs, seeds 0 and 1: 2 of 8 stayed up at 100, 4 at
-        # 300, 6 at 600 and 800, 5 at 1000, none at 10000, all with coasting; 7 at 800 with
-        # the roll's turn too; roll-tracking's RMSE 0.0150 rad at 100, 0.0149 at 300, 0.0181
-        # at 600, 0.0196 at 800, 0.0207 at 1000).
+        # The MPC's forces weigh the pair file's ``wbc.force_weight`` (the WBC's own default
+        # is 1): their distribution over the feet is what rolls a deck or a platform, and the
+        # CoM and orientation tasks leave it free (measurements: docs/tuning.md, "Pair files").
         sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
         settings_wbc = WbcSettings(
             springs="rigid" if sprung else "passive",
-            force_weight=robot.params.wbc_force_weight,
+            force_weight=tuning.force_weight,
             pyramid=self.pair.pyramid,
             solver=wbc_solver or solver_for("wbc"),
         )
@@ -304,10 +302,10 @@ class MpcRider(Controller):
             posture=motor_posture(self.pinocchio, robot, robot.ride_qpos(board)),
             platforms=rolling_platforms(loaded),
         )
-        self._feedforward = robot.params.wbc_feedforward
+        self._feedforward = tuning.feedforward
         tau = self.pair.force_time_constant  # the forces the WBC gets, low-passed
         self.force_filter = ForceFilter(tau) if tau is not None else None
-        scale = robot.params.tracking_gain_scale  # the QP's torques lead, the PD follows
+        scale = tuning.tracking_gain_scale  # the QP's torques lead, the PD follows
         self.kp = scale * np.array([m.kp for m in robot.motors])
         self.kd = tracking_damping(  # each delayed loop damped at its largest margin
             robot.mj_model,
@@ -333,26 +331,33 @@ class MpcRider(Controller):
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
         self.shoes = self._shoe_observer(loaded)
         # each shoe's heading from its direction of travel: the soles creep round on the pads
-        self.shoe_heading = ShoeHeading(self.shoes.platforms) if self.shoes is not None else None
-        n = self.layout.names  # each shoe's (x, y, heading, speed) indices in the MPC's state
+        self.shoe_heading = (
+            ShoeHeading(self.shoes.platforms)
+            if self.shoes is not None and stages.shoe_heading is not None
+            else None
+        )
+        self._guidance = stages.guidance is not None  # shoe headings turned onto their lines
+        quantities = ("x", "y", "heading", "speed")  # each shoe's, in the MPC's state
         self._shoe_columns = (
-            tuple((n[f"{p}x"], n[f"{p}y"], n[f"{p}psi"], n[f"{p}v"]) for p in self.layout.prefixes)
+            tuple(
+                tuple(columns[BoardState(k, q)] for q in quantities)
+                for k in sorted({state.platform for state in columns})
+            )
             if self.shoes is not None
             else ()
         )
-        deck = (
-            skateboard_model(loaded).reduced
-            if loaded is not None and isinstance(loaded.params, SkateboardParameters)
-            else None
-        )
-        self._steer_gain = deck.steer_gain if deck is not None else None
+        rolls = stages.roll_steering is not None or stages.roll_observer is not None
+        deck = skateboard_model(loaded).reduced if loaded is not None and rolls else None
+        steers = deck if stages.roll_steering is not None else None
+        self._steer_gain = steers.steer_gain if steers is not None else None
         # a yaw-rate command steered by the deck's roll, eq. (14) inverted
-        self.roll_steering = RollSteering(gain=deck.steer_gain) if deck is not None else None
+        self.roll_steering = RollSteering(gain=steers.steer_gain) if steers is not None else None
         self._blend: SwitchBlend | None = None  # a re-push's reference blended in
-        index, gain = self.layout.names, self.pair.roll_observer
+        gain = self.pair.roll_observer
+        roll, roll_rate = BoardState(0, "roll"), BoardState(0, "roll_rate")  # the deck's
         self.roll_observer = (
-            RollObserver(index["board_roll"], index["board_roll_rate"], deck, gain)
-            if deck is not None and gain is not None and "board_roll_rate" in index
+            RollObserver(columns[roll], columns[roll_rate], deck, gain)
+            if deck is not None and gain is not None and roll_rate in columns
             else None
         )
         self.stance = (
@@ -360,6 +365,10 @@ class MpcRider(Controller):
             if self.roll_observer is not None and self.pair.stance_roll is not None
             else None
         )
+        # Feet per side of the deck for a rider standing on it on two sides of feet (a
+        # quadruped's two), 0 for one foot a side: the roll observer's and the stance's sides.
+        n_feet = len(robot.params.foot_bodies)
+        self._side_feet = n_feet // 2 if n_feet >= 4 and n_feet % 2 == 0 else 0
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -389,12 +398,11 @@ class MpcRider(Controller):
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
-        """On Hovershoes, the observer of where each foot stands along its shoe and of each
-        shoe's drag."""
-        if board is None or not isinstance(board.params, HovershoesParameters):
+        """With the ``shoe_observer`` stage (Hovershoes), the observer of where each foot
+        stands along its shoe and of each shoe's drag."""
+        if board is None or self.pair.description.stages.shoe_observer is None:
             return None
-        shoes = wheeled_board(board)
-        assert isinstance(shoes, HovershoesBoard)
+        shoes = cast(HovershoesBoard, wheeled_board(board))
         names = self.wbc.model.foot_names
         platform_of = {foot: k for k, group in enumerate(self.platform_feet) for foot in group}
         sites = [platform_of.get(names[f], -1) for f in self.wbc.model.site_foot]
@@ -563,7 +571,9 @@ class MpcRider(Controller):
             self._diagnostics["lean_offset"] = self.lean.offset
         if self.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
-            states = steer_onto_lines(problem.state_reference, problem.initial_state, columns)
+            states = problem.state_reference
+            if self._guidance:
+                states = steer_onto_lines(states, problem.initial_state, columns)
             states = self.shoes.shift_reference(states, columns)
             c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
@@ -675,16 +685,16 @@ class MpcRider(Controller):
         """Whether both feet of one side (left or right of the deck's centre line, by their
         estimated places) are off the deck or planned within 1 N of the least force."""
         board, plan = estimate.board, self._plan
-        if board is None or plan is None or len(estimate.foot_position) != 4:
+        side, index = self._side_feet, self.mpc.reference.force_index
+        if board is None or plan is None or not side:
             return False
-        index = self.mpc.reference.force_index
-        if len(index) != 4:
+        if len(estimate.foot_position) != 2 * side or len(index) != 2 * side:
             return False
         contact = np.asarray(estimate.contact, dtype=bool)
         light = ~contact | (plan.first_input[index[:, 2]] <= self._least_force() + 1.0)
         across = _to_deck(board.yaw, estimate.foot_position[:, :2])[:, 1]
         order = np.argsort(across)
-        return bool(light[order[:2]].all() or light[order[2:]].all())
+        return bool(light[order[:side]].all() or light[order[side:]].all())
 
     def _stance_roll(
         self, roll: Array, estimate: EstimatedState, now: float, balancing: bool
@@ -699,7 +709,8 @@ class MpcRider(Controller):
             limit.reset()
             return roll
         feet = np.asarray(estimate.foot_position, dtype=float)
-        if len(feet) != 4 or not np.all(estimate.contact) or self._plan is None:
+        four = bool(self._side_feet) and len(feet) == 2 * self._side_feet
+        if not four or not np.all(estimate.contact) or self._plan is None:
             return np.clip(roll, *limit.last)
         com = self.map.com(estimate)
         centre = feet[:, :2].mean(axis=0)

@@ -5,20 +5,14 @@ The MPC predicts the deck's roll from eqs. (6)-(7),
 roll torque :math:`\\tau` taken from the plan's foot forces about the deck's estimated top
 centre (the centroid of the feet standing on it). That torque is biased and mis-scaled in
 closed loop, and the plans, which always expect the deck to settle where the model puts it,
-never correct what it gets wrong: the plans met the commanded roll at the horizon's end and
-the deck lagged it by 0.12-0.16 s, with a bias of +0.009 to +0.015 rad after a push-off.
-Measured (push-off-0.7, seed 0, feet-to-deck contact forces read from the simulator for the
-diagnosis only): the deck itself follows eq. (6)-(7) under the true foot torque (a fit gives
-:math:`K_B` = 46.4 N m/rad, :math:`B_B` = 1.65 N m s/rad against the identified 48.0 and
-1.56; residual 0.11 of 3.4 N m RMS), but the true torque is not the model's:
-
-- after the push-off the feet stand 5.6 mm to the right of the deck's centre line (the
-  pushing foot lands elsewhere than it lifted), and the estimate, which takes their centroid
-  for the deck's centre, cannot see it: 87 N x 5.6 mm = 0.5 N m, 0.010 rad of roll;
-- the estimated centre-of-mass offset from the deck, :math:`\\hat c_y - \\hat o_y`, is
-  0.89 of the true one, and the true torque per metre of offset is 98 N m/m, not the
-  weight's 87 (the sway's lateral force acts 0.23 m below the centre of mass): per metre of
-  estimated offset the deck rolls 2.37 rad, the model 1.82.
+never correct what it gets wrong: the plans meet the commanded roll at the horizon's end and
+the deck lags it, with a bias after a push-off. The deck itself follows eq. (6)-(7) under
+the true foot torque, but the true torque is not the model's: after a push-off the feet
+stand off the deck's centre line (the pushing foot lands elsewhere than it lifted), which
+the estimate, taking their centroid for the deck's centre, cannot see; and the estimated
+centre-of-mass offset from the deck, :math:`\\hat c_y - \\hat o_y`, is smaller than the
+true one, while the sway's lateral force, acting below the centre of mass, adds to the
+torque per metre of offset (the diagnosis, measured: ``docs/tuning.md``).
 
 As in offset-free MPC, a disturbance torque :math:`d` [N m] is added to the deck's roll
 row, held over the horizon, and integrated from the error of the last plan's prediction

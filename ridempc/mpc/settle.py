@@ -4,9 +4,8 @@ The skateboard library's entries end with the centre of mass 6.4-8.7 cm ahead of
 stood at the start, over the four feet (nothing in the trajectory optimisation's cost keeps
 it back: 0.3-1.0 m/s; 7.3-9.5 cm in the library before ``SkateOptions.liftoff_force``), and
 a reference held at its last node (:func:`~ridempc.mpc.reference.steady_riding`) keeps the
-rider there for the rest of the ride. With that earlier library the dog then stood with
-80-97 % of its weight on its front feet, and on push-off-1.0, seed 25, a rear foot carrying
-0-3 N drifted off the rolling deck at 14.7 s and the ride fell.
+rider there for the rest of the ride, its weight on its front feet and its rear feet light
+enough to drift off a rolling deck (``docs/tuning.md``).
 
 :func:`settle_over_feet` gives the reference an offset that grows after its end, over
 ``duration`` [s], by a smoothstep :math:`s(\\tau) = 3\\tau^2 - 2\\tau^3`,
@@ -29,12 +28,14 @@ rider there for the rest of the ride. With that earlier library the dog then sto
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from ridempc.boards.canonical import BoardState, board_state_columns
 from ridempc.errors import ConfigError
 from ridempc.mpc.reference import MotionReference
 from ridempc.trajopt.rigid_body import RigidBodyRobot, feet_world
@@ -43,7 +44,6 @@ from ridempc.trajopt.rotations import rotation_z
 __all__ = ["FOOT_TOLERANCE", "settle_over_feet"]
 
 Array = NDArray[np.float64]
-_BOARD = ("com_x", "com_y", "board_x", "board_y", "board_yaw")
 FOOT_TOLERANCE: float = 1e-6  # [m] how far the settled joints may leave a foot
 # Solved offsets by reference (its name, first and last nodes, forces, settle time): the
 # least squares take 7-10 ms, and the rider retargets inside an MPC tick.
@@ -51,15 +51,19 @@ _SOLVED: dict[tuple[object, ...], tuple[Array, Array]] = {}
 
 
 def settle_over_feet(
-    reference: MotionReference, robot: RigidBodyRobot, duration: float
+    reference: MotionReference,
+    robot: RigidBodyRobot,
+    duration: float,
+    board_states: Mapping[str, BoardState],
 ) -> MotionReference:
     """``reference`` settling back over the feet after its end (module docstring).
 
     Args:
-        reference: A reference on one board (states ``com_*``, ``trunk_*``, ``q_*`` and
-            ``board_x``, ``board_y``, ``board_yaw``).
+        reference: A reference on one board (states ``com_*``, the base's angles, ``q_*``
+            and the board's x, y and heading).
         robot: The SRBKM robot of its states.
         duration: Time the settle takes after the end [s].
+        board_states: What each board state is (:mod:`ridempc.boards.canonical`).
 
     Raises:
         ConfigError: The reference has no single board, its joints do not fit the robot,
@@ -76,7 +80,7 @@ def settle_over_feet(
     )
     solved = _SOLVED.get(key)
     if solved is None:
-        solved = _SOLVED[key] = _offsets(reference, robot)
+        solved = _SOLVED[key] = _offsets(reference, robot, board_states)
     states, inputs = solved
     return replace(
         reference,
@@ -86,7 +90,9 @@ def settle_over_feet(
     )
 
 
-def _offsets(reference: MotionReference, robot: RigidBodyRobot) -> tuple[Array, Array]:
+def _offsets(
+    reference: MotionReference, robot: RigidBodyRobot, board_states: Mapping[str, BoardState]
+) -> tuple[Array, Array]:
     """The settled offsets of the states and the inputs (module docstring).
 
     Raises:
@@ -94,20 +100,24 @@ def _offsets(reference: MotionReference, robot: RigidBodyRobot) -> tuple[Array, 
     """
     names = reference.state_names
     joints = [k for k, n in enumerate(names) if n.startswith("q_")]
-    layout = names[:3] == ("com_x", "com_y", "com_z") and names[3].endswith("_roll")
-    if not (layout and set(_BOARD) <= set(names)) or len(joints) != robot.n_joints:
+    layout = names[:4] == ("com_x", "com_y", "com_z", f"{robot.base}_roll")
+    columns = board_state_columns(names, board_states)
+    deck = [columns.get(BoardState(0, q)) for q in ("x", "y", "heading")]
+    one_board = {state.platform for state in columns} == {0} and None not in deck
+    if not (layout and one_board) or len(joints) != robot.n_joints:
         raise ConfigError(
             f"reference '{reference.name}': no single board and {robot.n_joints} joints "
             "to settle on"
         )
     i = names.index
+    bx, by, yaw = (int(k) for k in deck if k is not None)
     first, last = reference.states[0], reference.states[-1]
 
     def on_board(x: Array) -> Array:
-        offset = [x[i("com_x")] - x[i("board_x")], x[i("com_y")] - x[i("board_y")], 0.0]
-        return np.asarray(rotation_z(-x[i("board_yaw")]) @ offset)
+        offset = [x[i("com_x")] - x[bx], x[i("com_y")] - x[by], 0.0]
+        return np.asarray(rotation_z(-x[yaw]) @ offset)
 
-    heading = float(last[i("board_yaw")])
+    heading = float(last[yaw])
     shift = rotation_z(heading) @ (on_board(first) - on_board(last))
     com, euler = last[0:3], last[3:6]  # eq. (1)'s layout: CoM, then roll, pitch, yaw
     q_end = last[joints]
@@ -128,7 +138,7 @@ def _offsets(reference: MotionReference, robot: RigidBodyRobot) -> tuple[Array, 
     states[[i("com_x"), i("com_y")]] = shift[:2]
     states[joints] = solved.x - q_end
     inputs = np.zeros(reference.inputs.shape[1])
-    turn = rotation_z(heading - float(first[i("board_yaw")]))
+    turn = rotation_z(heading - float(first[yaw]))
     for rows in reference.force_index:
         inputs[rows] = turn @ reference.inputs[0, rows] - reference.inputs[-1, rows]
     return states, inputs

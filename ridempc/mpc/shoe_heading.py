@@ -4,17 +4,14 @@ The estimator reads a Hovershoe's heading off the toe line of the foot standing 
 (:mod:`ridempc.estimation.board`), and assumes the sole holds on the pad. It does not quite:
 a turning shoe's wheel scrubs, eq. (5)'s :math:`c_3\\dot\\psi` (18 N m s/rad: 7 N m at 0.4
 rad/s), the sole turns it through friction alone, and it creeps round on the pad at a
-quarter of its friction limit. On the circle (0.8 m/s at 0.4 rad/s, seed 0) the toe lines
-ran ahead of their shoes by 0.05/0.08 rad (left/right) at 10 s and 0.22/0.23 rad at 24 s,
-as the estimate had them. The MPC, seeing shoes turned that much further than they were,
-let them lag the rider; the outer shoe ran wide and the rider ended in the splits
-(spacing 0.42 m -> 0.84 m at 25 s). The creep is MuJoCo's soft friction, which the
-scene's 10 no-slip iterations do not quite take out; at 50 it is gone, but so is the
-tyres' creep on the ground, and the shoes' yaw no longer fits eq. (5) (identification
-fails: held-out yaw-rate NRMSE 1.2), so the scene is left as it is, and a sole may slip on
-a real pad too. The heading the feet cannot tell, their direction of travel can: a wheel
-rolls along its heading and does not slide sideways, so at speed the foot moves along its
-shoe. Per shoe, the slip of the toe line on the pad is low-passed from the difference:
+quarter of its friction limit: in a long turn the toe lines run ahead of their shoes by
+tenths of a radian, the MPC, seeing shoes turned further than they are, lets them lag the
+rider, and the outer shoe runs wide. The creep is MuJoCo's soft friction, which the
+scene's no-slip iterations do not quite take out (more of them would take out the tyres'
+creep too, which eq. (5) needs), and a sole may slip on a real pad too. The heading the
+feet cannot tell, their direction of travel can: a wheel rolls along its heading and does
+not slide sideways, so at speed the foot moves along its shoe. Per shoe, the slip of the
+toe line on the pad is low-passed from the difference:
 
 .. math::
 
@@ -27,13 +24,8 @@ line's heading, :math:`T` = ``TIME_CONSTANT`` [s] and :math:`\\Delta t` [s] the 
 above ``MIN_SPEED``, below which the direction of travel is noise and :math:`s` is held.
 The toe line keeps the heading's fast part, the travel its slow part. The foot's own
 turn about the wheel's yaw axis adds :math:`\\dot\\psi\\, d` [m/s] sideways at a foot
-:math:`d` ahead of it (under 0.03 rad at 0.8 m/s, 0.4 rad/s and 5 cm), left in.
-
-Measured (circle, seeds 0/1): foot-spacing RMSE 0.075/0.057 -> 0.024/0.024 m (the spacing
-held within 0.42-0.45 m to the end), velocity RMSE 0.059/0.058 -> 0.008/0.009 m/s, yaw-rate
-RMSE 0.048/0.031 -> 0.027/0.026 rad/s; the other Hovershoes scenarios within 0.0006 of
-their figures. The creep is then taken up by the hips' yaw: the right one stood at 0.30 of
-its 0.39 rad at 25 s.
+:math:`d` ahead of it (under 0.03 rad at 0.8 m/s, 0.4 rad/s and 5 cm), left in. The creep
+is then taken up by the hips' yaw.
 """
 
 from __future__ import annotations

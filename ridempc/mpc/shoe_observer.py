@@ -53,15 +53,14 @@ balances are fitted by least squares with exponential forgetting over ``MEMORY``
 
 over the ticks with a load over ``MIN_LOAD``, :math:`d` held within ``LIMIT``. Early in a
 ride the fit rests on the few ticks it has and finds a misplaced foot within a tenth of a
-second; later it averages over :math:`T`: fitted tick by tick at 4 Hz, the offset rang with
-the shoes' 4 Hz pitch and fed it (stand-still's yaw-rate RMSE 0.034 -> 0.12 rad/s).
+second; later it averages over :math:`T` (fitted tick by tick, the offset would ring with
+the shoes' 4 Hz pitch and feed it).
 
 **Use.** The MPC sees each shoe's axis :math:`d` behind its foot (:meth:`ShoeObserver.shift`),
 wants it :math:`d` behind where the reference puts the foot
 (:meth:`ShoeObserver.shift_reference`: the library's shoes carry their feet over their axes,
-and held to the library's shoes side by side, a rider on shoes staggered by 6 cm scissored
-her feet 10 cm apart to line the axes up and fell at 3.65 s), and has :math:`D` in its
-speed equations (:meth:`ShoeObserver.speed_drift`).
+and held to them a rider on staggered shoes would scissor her feet to line the axes up), and
+has :math:`D` in its speed equations (:meth:`ShoeObserver.speed_drift`).
 """
 
 from __future__ import annotations

@@ -6,8 +6,7 @@ Per metre of the estimated centre-of-mass offset from the feet's centroid
 (:math:`\\hat c_y - \\hat o_y`) the deck rolls 2.37 rad in closed loop
 (:mod:`~ridempc.mpc.roll_observer`): a roll :math:`\\varphi` asks for
 :math:`y(\\varphi) = y_0 - s\\varphi` with :math:`s` = 0.42 m/rad, :math:`y_0` the offset
-that holds the deck level. Measured on push-off-1.0 (seed 0) at the roll wave's 0.1 rad:
-0.40-0.44 m/rad of estimated offset.
+that holds the deck level (0.40-0.44 m/rad measured at the roll wave's 0.1 rad).
 
 The offset must stay inside the stance: while the far-side feet still carry the MPC's
 least force on a deck :math:`f_{min}` each, the load's moment about the near side's line
@@ -22,12 +21,8 @@ with :math:`y_R, y_L` the right and left lines' lateral places (deck frame, from
 centroid) and :math:`m` a margin [m]. The bounds on :math:`\\varphi` follow from the
 estimated :math:`y_0 = \\hat y + s\\hat\\varphi` (the offset and roll now), low-passed over
 ``time_constant`` (the sway swings it +-1 cm at the roll wave's 3 s period). On a normal
-stance (push-off-1.0 seed 0: lines at -0.085 and +0.088 m, :math:`y_0` = -0.004 m) the
-bound lies at 0.11 rad, beyond the roll wave's 0.1. After push-off-1.0 seed 5's fourth
-stroke the front-right foot landed 57 mm inward: its line lay 0.061 m right of the
-centroid with :math:`y_0` = -0.025 m, and the wave's +0.1 rad pushed the estimated offset
-to -0.053 m, the left feet to the least force and off the deck, and the dog over its right
-feet (fell at 9.14 s).
+stance the bound lies beyond the roll wave's 0.1 rad; it binds where a foot has landed
+inward, narrowing the stance (``docs/tuning.md``).
 """
 
 from __future__ import annotations
@@ -77,8 +72,7 @@ class StanceLimit:
         time_constant: Of the low-pass on :math:`y_0` [s].
         level: :math:`y_0` [m], or None before the first update.
         last: The last bounds [rad], held while a foot is off the deck (its place is not
-            the stance's then; passing the command through, push-off-1.0 seed 5 rolled to
-            0.1 rad on two feet and fell at 9.55 s).
+            the stance's then).
     """
 
     offset_per_roll: float

@@ -166,6 +166,8 @@ class StateMap:
         state_names: The pair's state layout.
         platform_prefixes: The board-state prefix of each platform estimate, estimator
             order (``("board_",)``, ``("left_", "right_")``, ``("segway_",)``).
+        base: The robot's base body (its description's ``base_body``): the states
+            ``<base>_roll``, ``<base>_pitch``, ``<base>_yaw`` are its Z-Y-X angles.
 
     Raises:
         ConfigError: A state name the map cannot fill.
@@ -176,8 +178,11 @@ class StateMap:
         robot: PinocchioRobot,
         state_names: Sequence[str],
         platform_prefixes: Sequence[str],
+        *,
+        base: str,
     ) -> None:
         self.robot = robot
+        self.base = base  # the base body, whose angles are ``<base>_roll`` ...
         self.data = robot.model.createData()
         self.names = tuple(state_names)
         self.prefixes = tuple(platform_prefixes)
@@ -199,7 +204,7 @@ class StateMap:
         if name in ("wx", "wy", "wz"):
             return ("omega", "xyz".index(name[1]))
         for k, angle in enumerate(("roll", "pitch", "yaw")):
-            if name in (f"trunk_{angle}", f"pelvis_{angle}"):
+            if name == f"{self.base}_{angle}":
                 return ("base_angle", k)
         if name.startswith("q_"):
             return ("joint", name[2:])

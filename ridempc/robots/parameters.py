@@ -18,7 +18,7 @@ from pathlib import Path
 from pydantic import Field, model_validator
 
 from ridempc.tomlfile import load_checked
-from ridempc.units import CheckedModel, NonNegative, Positive, Real
+from ridempc.units import CheckedModel, NonNegative, Positive
 
 __all__ = ["MotorParameters", "RobotParameters", "load_robot_parameters"]
 
@@ -96,37 +96,6 @@ class RobotParameters(_Frozen):
     )
     motors: dict[str, MotorParameters] = Field(
         min_length=1, description="Per motor, keyed by actuator name."
-    )
-    tracking_gain_scale: Real = Field(
-        default=1.0,
-        gt=0.0,
-        le=1.0,
-        description=(
-            "Fraction of the motors' PD gains used about the joint targets of a whole-body "
-            "controller whose torques go out as feedforward (the MPC rider) [-]."
-        ),
-    )
-    wbc_force_weight: Real = Field(
-        default=100.0,
-        gt=0.0,
-        le=1e6,  # beyond it the QP's other tasks vanish below OSQP's tolerances
-        description=(
-            "Weight of the MPC's contact forces in the MPC rider's whole-body QP, per unit "
-            "of whole-body acceleration [(kg/N)^2] (WbcSettings.force_weight)."
-        ),
-    )
-
-    wbc_feedforward: Real = Field(
-        default=0.0,
-        ge=0.0,
-        le=1.0,
-        description=(
-            "Share of the MPC plan's first-step accelerations (centre of mass and base "
-            "rotation, (x_1 - x_0) / dt) that the MPC rider's whole-body QP feeds forward in "
-            "its motion tasks [-]. Without it those tasks, aimed at the plan's next state, "
-            "resist the plan's own forces; with Cassie's noisier estimate the first step "
-            "carries its corrections (up to 40 rad/s^2) and she falls within 2 s."
-        ),
     )
 
     @model_validator(mode="after")

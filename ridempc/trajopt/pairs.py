@@ -1,10 +1,10 @@
-"""Robot-board pairs the trajectory optimisation knows, chosen by name.
+"""Robot-board pairs the trajectory optimisation knows: those with a pair file.
 
-A pair is a module exposing ``PAIR``, a :class:`Pair`: how to turn target values into library
-entries, how to check a target before solving, how to build an entry's NLP and its initial
-guess (cold, or warm from a neighbouring entry), and the continuous dynamics the stored
-trajectories follow. The table :data:`PAIRS` maps ``<robot>-<board>`` to that module, so a
-new pair is a new module and one line here.
+A pair is a :class:`Pair`: how to turn target values into library entries, how to check a
+target before solving, how to build an entry's NLP and its initial guess (cold, or warm from
+a neighbouring entry), and the continuous dynamics the stored trajectories follow. It is made
+from the pair's file (``pairs/<robot>-<board>.toml``, :mod:`ridempc.pair_description`) by the
+builder of the trajectory problem the file names (:data:`PROBLEMS`): a new pair is a new file.
 """
 
 from __future__ import annotations
@@ -12,23 +12,28 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import cache
 from typing import Any, NamedTuple
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.errors import UnknownNameError
+from ridempc.pair_description import (
+    PairDescription,
+    load_pair_description,
+    pair_description_names,
+)
 from ridempc.trajopt.problem import TrajectoryProblem
 
-__all__ = ["PAIRS", "EntrySpec", "Guess", "Neighbour", "Pair", "load_pair", "pair_names"]
+__all__ = ["PROBLEMS", "EntrySpec", "Guess", "Neighbour", "Pair", "load_pair", "pair_names"]
 
 Array = NDArray[np.float64]
 
-PAIRS: dict[str, str] = {
-    "cyberdog2-skateboard": "ridempc.trajopt.skate_pair",
-    "cassie-hovershoes": "ridempc.trajopt.hovershoes_pair",
-    "cassie-segway": "ridempc.trajopt.segway_pair",
+# A pair file's ``trajopt.problem`` -> the module whose ``make_pair`` builds its Pair.
+PROBLEMS: dict[str, str] = {
+    "ride": "ridempc.trajopt.ride_pair",
+    "skate": "ridempc.trajopt.skate_pair",
 }
 
 
@@ -101,18 +106,19 @@ class Pair(NamedTuple):
 
 
 def pair_names() -> tuple[str, ...]:
-    return tuple(sorted(PAIRS))
+    """The pairs described in ``pairs/``."""
+    return pair_description_names()
 
 
+@cache
 def load_pair(robot: str, board: str) -> Pair:
-    """The pair of that robot and board.
+    """The pair of that robot and board, made from its pair file (once per process).
 
     Raises:
-        UnknownNameError: No trajectory optimisation exists for that pair; the message lists
-            the pairs that have one.
+        UnknownNameError: No pair file for that pair; the message lists the pairs described.
+        ConfigError: The pair file is malformed or does not fit its robot and board.
     """
-    name = f"{robot}-{board}"
-    if name not in PAIRS:
-        raise UnknownNameError("robot-board pair", name, PAIRS)
-    pair: Pair = importlib.import_module(PAIRS[name]).PAIR
-    return pair
+    description = load_pair_description(robot, board)
+    module = importlib.import_module(PROBLEMS[description.trajopt.problem])
+    make: Callable[[PairDescription], Pair] = module.make_pair
+    return make(description)

@@ -20,23 +20,35 @@ lower). Each class is data plus the few functions the ride problem calls.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState, canonical_board_states
 from ridempc.boards.hovershoes.parameters import HovershoesParameters, HovershoesReducedParameters
 from ridempc.boards.hovershoes.reduced import STATE_NAMES as SHOE_STATE
+from ridempc.boards.hovershoes.reduced import STATE_QUANTITIES as SHOE_QUANTITIES
 from ridempc.boards.hovershoes.reduced import contact_torques, shoe_dynamics
 from ridempc.boards.segway.parameters import SegwayParameters, SegwayReducedParameters
 from ridempc.boards.segway.reduced import STATE as SEGWAY_STATE
+from ridempc.boards.segway.reduced import STATE_QUANTITIES as SEGWAY_QUANTITIES
 from ridempc.boards.segway.reduced import segway_dynamics
 from ridempc.errors import ConfigError
 from ridempc.trajopt.rotations import rotation_z, stack3x3
 
-__all__ = ["HovershoesBoard", "SegwayBoard", "WheeledBoard", "platform_pushes", "wheeled_board"]
+__all__ = [
+    "SIDES",
+    "HovershoesBoard",
+    "SegwayBoard",
+    "WheeledBoard",
+    "platform_pushes",
+    "wheeled_board",
+]
+
+SIDES: tuple[str, ...] = ("left", "right")  # the Hovershoes' shoes, in platform order
 
 Array = NDArray[np.float64]
 
@@ -99,7 +111,15 @@ class HovershoesBoard(_Common):
 
     @property
     def n_platforms(self) -> int:
-        return 2
+        return len(SIDES)
+
+    def platform_prefixes(self) -> tuple[str, ...]:
+        """Each shoe's prefix of its state names, in platform order (left, right)."""
+        return tuple(f"{side}_" for side in SIDES)
+
+    def board_states(self) -> dict[str, BoardState]:
+        """Each state name as its canonical quantity, per shoe (left, right)."""
+        return canonical_board_states(self.platform_prefixes(), SHOE_QUANTITIES)
 
     def platform_state(self, xb: Any, platform: int) -> Any:
         return xb[7 * platform : 7 * platform + 7]
@@ -154,6 +174,14 @@ class SegwayBoard(_Common):
     @property
     def n_platforms(self) -> int:
         return 1
+
+    def platform_prefixes(self) -> tuple[str, ...]:
+        """The platform's prefix of its state names (the board's name)."""
+        return (f"{self.name}_",)
+
+    def board_states(self) -> dict[str, BoardState]:
+        """Each state name as its canonical quantity (one platform)."""
+        return canonical_board_states(self.platform_prefixes(), SEGWAY_QUANTITIES)
 
     def pose(self, xb: Any, platform: int) -> tuple[Any, Any]:
         rotation = rotation_z(xb[2], ca) @ _rotation_y(xb[3])
@@ -211,9 +239,11 @@ def wheeled_board(board: Board, pitch_limit: float = 0.25) -> WheeledBoard:
         raise ConfigError(
             f"{board.folder / 'board.toml'}: no [reduced] table; run `ridempc board identify`"
         )
-    if isinstance(params, HovershoesParameters):
+    features = board.kind.features
+    if "shoes" in features:
+        params = cast(HovershoesParameters, params)
         assert params.reduced is not None
-        names = tuple(f"{side}_{n}" for side in ("left", "right") for n in SHOE_STATE)
+        names = tuple(f"{side}_{n}" for side in SIDES for n in SHOE_STATE)
         return HovershoesBoard(
             name=board.name,
             top=params.platform_height,
@@ -227,14 +257,15 @@ def wheeled_board(board: Board, pitch_limit: float = 0.25) -> WheeledBoard:
             reduced=params.reduced,
             shoe_mass=board.mass / 2.0,
         )
-    if isinstance(params, SegwayParameters):
+    if "knee_bar" in features:
+        params = cast(SegwayParameters, params)
         assert params.reduced is not None
         return SegwayBoard(
             name=board.name,
             top=params.platform_height,
             speed_limit=params.top_speed,
             pitch_limit=pitch_limit,
-            state_names=tuple(f"segway_{n}" for n in SEGWAY_STATE),
+            state_names=tuple(f"{board.name}_{n}" for n in SEGWAY_STATE),
             input_names=("knee_bar",),
             input_bound=np.array([np.radians(params.knee_bar_range)]),
             yaw_torque_limit=float("inf"),

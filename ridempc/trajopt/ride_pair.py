@@ -18,6 +18,7 @@ import numpy as np
 
 from ridempc.boards import load_board
 from ridempc.errors import ConfigError
+from ridempc.pair_description import PairDescription, load_pair_description
 from ridempc.robots import load_robot
 from ridempc.trajopt.pairs import EntrySpec, Guess, Neighbour, Pair
 from ridempc.trajopt.platforms import WheeledBoard, wheeled_board
@@ -31,22 +32,20 @@ from ridempc.trajopt.ride_problem import (
 )
 from ridempc.trajopt.rider import RiderModel, build_rider
 
-__all__ = ["make_ride_pair", "ride_models"]
-
-# Cassie's hips: the hip-pitch joints; legs between 85 % and 103 % of the riding stance's.
-HIPS = {"cassie": ("left_hip_pitch", "right_hip_pitch")}
-LEG_RANGE = (0.85, 1.03)
+__all__ = ["make_pair", "make_ride_pair", "ride_models"]
 
 
 @cache
 def ride_models(robot_name: str, board_name: str) -> tuple[RiderModel, WheeledBoard]:
-    """The simplified rider at its riding keyframe for the board, and the board (built once)."""
+    """The simplified rider at its riding keyframe for the board, its hips and leg range
+    from the pair file, and the board (built once)."""
+    trajopt = load_pair_description(robot_name, board_name).trajopt
     robot = load_robot(robot_name)
     board = load_board(board_name)
     if board is None:
         raise ConfigError(f"board '{board_name}' is missing")
     keyframe = robot.params.stance_keyframes.get(board_name, robot.params.stand_keyframe)
-    rider = build_rider(robot, keyframe, HIPS[robot_name], LEG_RANGE)
+    rider = build_rider(robot, keyframe, trajopt.hips, trajopt.leg_range)
     return rider, wheeled_board(board)
 
 
@@ -134,4 +133,14 @@ def make_ride_pair(
         guess=guess,
         rates=rates,
         board_states=board_states,
+    )
+
+
+def make_pair(description: PairDescription) -> Pair:
+    """The :class:`Pair` a ``ride`` pair file describes (its targets and option defaults)."""
+    return make_ride_pair(
+        description.robot,
+        description.board,
+        description.trajopt.default_targets,
+        description.trajopt.problem_options(),
     )

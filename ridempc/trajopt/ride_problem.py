@@ -55,7 +55,6 @@ __all__ = ["KINDS", "RideOptions", "build_ride_problem", "ride_guess", "ride_lay
 
 Array = NDArray[np.float64]
 KINDS = ("accelerate", "stop", "turn")
-_RIDER = rigid_body_state_names("pelvis")
 
 
 @dataclass(frozen=True)
@@ -201,7 +200,7 @@ def build_ride_problem(
     platform_of = layout["platform_of"]
     nc, nb, np_ = rider.n_contacts, len(board.state_names), board.n_platforms
     nx = 12 + nb
-    state_names = (*_RIDER, *board.state_names)
+    state_names = (*rigid_body_state_names(rider.body.base), *board.state_names)
     input_names = (
         *(f"f_{c}_{a}" for c in rider.contacts for a in "xyz"),
         *board.input_names,

@@ -105,6 +105,8 @@ class RigidBodyRobot:
         feet_in_trunk: CasADi function :math:`q_j \\mapsto (p^{trunk}_1, \\dots)`: contact
             sites in the trunk frame [m], one 3 x 1 output per foot.
         q_full_reference: Pinocchio configuration of the reference stance, base at the origin.
+        base: The base body (the robot description's ``base_body``), whose Z-Y-X angles
+            the states carry (:func:`rigid_body_state_names`).
     """
 
     name: str
@@ -123,6 +125,7 @@ class RigidBodyRobot:
     legs: tuple[tuple[int, ...], ...]
     feet_in_trunk: ca.Function
     q_full_reference: Array
+    base: str
 
     @property
     def n_joints(self) -> int:
@@ -215,6 +218,7 @@ def build_rigid_body_robot(robot: Robot, keyframe: str) -> RigidBodyRobot:
         legs=tuple(legs),
         feet_in_trunk=feet_in_trunk,
         q_full_reference=q_full,
+        base=robot.params.base_body,
     )
 
 

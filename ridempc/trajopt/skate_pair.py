@@ -1,4 +1,4 @@
-"""CyberDog2 on the skateboard: acceleration trajectories to target speeds (skateboard paper).
+"""A quadruped on the skateboard: acceleration trajectories to target speeds (skateboard paper).
 
 Each target speed gives an entry ``accelerate-<v>``: from rest in the riding keyframe to
 the board at :math:`v` with all four feet back on the deck (:mod:`.skate_problem`). A
@@ -12,8 +12,8 @@ nearest solved one of their kind by mapping its phases onto the new schedule.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
-from functools import lru_cache
+from collections.abc import Mapping, Sequence
+from functools import cache, lru_cache
 from typing import Any
 
 import casadi as ca
@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from ridempc.boards import load_board
 from ridempc.errors import ConfigError
+from ridempc.pair_description import PairDescription
 from ridempc.robots import load_robot
 from ridempc.trajopt.pairs import EntrySpec, Guess, Neighbour, Pair
 from ridempc.trajopt.problem import TrajectoryProblem
@@ -35,40 +36,43 @@ from ridempc.trajopt.skate_problem import (
 )
 from ridempc.trajopt.skateboard import BOARD_STATE, SkateboardModel, skateboard_model
 
-__all__ = ["PAIR", "REPUSH_GAIN", "repush_entry", "skate_models", "skate_options"]
+__all__ = ["REPUSH_GAIN", "make_pair", "repush_entry", "skate_models", "skate_options"]
 
 Array = NDArray[np.float64]
-ROBOT, BOARD = "cyberdog2", "skateboard"
 # [m/s] the speed a re-push regains: what the board loses coasting for 1.25 s (0.16 m/s^2 of
 # rolling resistance), within one stride's 0.3 m/s (speed_per_stride)
 REPUSH_GAIN: float = 0.2
 
 
-@lru_cache(maxsize=1)
-def skate_models() -> tuple[RigidBodyRobot, SkateboardModel]:
-    """The SRBKM CyberDog2 at its ``skateboard`` stance and the skateboard (built once)."""
-    robot = load_robot(ROBOT)
-    keyframe = robot.params.stance_keyframes.get(BOARD, robot.params.stand_keyframe)
-    board = load_board(BOARD)
+@cache
+def skate_models(robot_name: str, board_name: str) -> tuple[RigidBodyRobot, SkateboardModel]:
+    """The SRBKM robot at its stance on the board, and the skateboard (built once)."""
+    robot = load_robot(robot_name)
+    keyframe = robot.params.stance_keyframes.get(board_name, robot.params.stand_keyframe)
+    board = load_board(board_name)
     if board is None:
-        raise ConfigError(f"board '{BOARD}' is missing")
+        raise ConfigError(f"board '{board_name}' is missing")
     return build_rigid_body_robot(robot, keyframe), skateboard_model(board)
 
 
 @lru_cache(maxsize=8)
-def _speed_bound(options: SkateOptions) -> float:
-    return speed_bound(skate_models()[0], options)
+def _speed_bound(robot_name: str, board_name: str, options: SkateOptions) -> float:
+    return speed_bound(skate_models(robot_name, board_name)[0], options)
 
 
-def skate_options(overrides: dict[str, Any]) -> SkateOptions:
-    """:class:`SkateOptions` with ``overrides``; an unknown field is a ConfigError."""
+def skate_options(
+    overrides: Mapping[str, Any], defaults: Mapping[str, Any] | None = None
+) -> SkateOptions:
+    """:class:`SkateOptions` with the pair's ``defaults``, then ``overrides``; an unknown
+    field is a ConfigError."""
+    merged = {**(defaults or {}), **overrides}
     fields = {f.name for f in dataclasses.fields(SkateOptions)}
-    unknown = sorted(set(overrides) - fields)
+    unknown = sorted(set(merged) - fields)
     if unknown:
         raise ConfigError(
             f"unknown skateboard option '{unknown[0]}' (valid: {', '.join(sorted(fields))})"
         )
-    return dataclasses.replace(SkateOptions(), **overrides)
+    return dataclasses.replace(SkateOptions(), **merged)
 
 
 def _entries(targets: Sequence[float]) -> list[EntrySpec]:
@@ -83,33 +87,6 @@ def repush_entry(target: float) -> EntrySpec:
     """The ``repush`` entry to ``target`` [m/s], from a board rolling :data:`REPUSH_GAIN`
     slower (build it with :func:`ridempc.library.build.solve_entry`)."""
     return EntrySpec("repush", float(target), {"start_speed": round(target - REPUSH_GAIN, 6)})
-
-
-def _check(spec: EntrySpec) -> None:
-    if spec.kind not in ("accelerate", "repush"):
-        raise ConfigError(
-            f"{ROBOT}-{BOARD} has no '{spec.kind}' trajectories (valid: accelerate, repush)"
-        )
-    options = skate_options(spec.options)
-    bound = _speed_bound(options)
-    if not 0.0 < spec.target <= bound:
-        raise ConfigError(
-            f"target {spec.target:g} m/s is unreachable for {ROBOT} on the {BOARD}: no push "
-            f"can help beyond {bound:.1f} m/s (the pushing foot, still on the ground for at "
-            f"least {options.min_push:g} s, would have to sweep farther or faster than its "
-            "leg allows); targets must be in (0, that]"
-        )
-    if (spec.kind == "repush") != (options.start_speed > 0.0) or options.start_speed >= spec.target:
-        raise ConfigError(
-            f"{spec.name}: start_speed {options.start_speed:g} m/s; allowed: 0 for "
-            "accelerate, between 0 and the target for repush"
-        )
-
-
-def _build(spec: EntrySpec) -> TrajectoryProblem:
-    _check(spec)
-    robot, board = skate_models()
-    return build_skate_problem(robot, board, spec.target, skate_options(spec.options), spec.name)
 
 
 def _phase_map(new: list[str], old: list[str]) -> list[int]:
@@ -167,33 +144,64 @@ def _warm(problem: TrajectoryProblem, neighbour: Neighbour) -> Guess:
     return Guess(states, inputs, None)
 
 
-def _guess(problem: TrajectoryProblem, neighbour: Neighbour | None) -> Guess:
-    robot, board = skate_models()
-    if neighbour is not None and neighbour.metadata.get("pair") == problem.metadata["pair"]:
-        return _warm(problem, neighbour)
-    states, inputs = skate_guess(robot, board, problem)
-    return Guess(states, inputs, None)
+def make_pair(description: PairDescription) -> Pair:
+    """The :class:`Pair` a ``skate`` pair file describes (its targets and option defaults)."""
+    robot_name, board_name = description.robot, description.board
+    defaults = dict(description.trajopt.problem_options())
 
+    def check(spec: EntrySpec) -> None:
+        if spec.kind not in ("accelerate", "repush"):
+            raise ConfigError(
+                f"{robot_name}-{board_name} has no '{spec.kind}' trajectories "
+                "(valid: accelerate, repush)"
+            )
+        options = skate_options(spec.options, defaults)
+        bound = _speed_bound(robot_name, board_name, options)
+        if not 0.0 < spec.target <= bound:
+            raise ConfigError(
+                f"target {spec.target:g} m/s is unreachable for {robot_name} on the "
+                f"{board_name}: no push can help beyond {bound:.1f} m/s (the pushing foot, "
+                f"still on the ground for at least {options.min_push:g} s, would have to "
+                "sweep farther or faster than its leg allows); targets must be in (0, that]"
+            )
+        if (spec.kind == "repush") != (options.start_speed > 0.0) or (
+            options.start_speed >= spec.target
+        ):
+            raise ConfigError(
+                f"{spec.name}: start_speed {options.start_speed:g} m/s; allowed: 0 for "
+                "accelerate, between 0 and the target for repush"
+            )
 
-def _rates(metadata: dict[str, Any]) -> ca.Function:
-    robot, board = skate_models()
-    return skate_rates(robot, board)
+    def build(spec: EntrySpec) -> TrajectoryProblem:
+        check(spec)
+        robot, board = skate_models(robot_name, board_name)
+        options = skate_options(spec.options, defaults)
+        return build_skate_problem(robot, board, spec.target, options, spec.name)
 
+    def guess(problem: TrajectoryProblem, neighbour: Neighbour | None) -> Guess:
+        robot, board = skate_models(robot_name, board_name)
+        if neighbour is not None and neighbour.metadata.get("pair") == problem.metadata["pair"]:
+            return _warm(problem, neighbour)
+        states, inputs = skate_guess(robot, board, problem)
+        return Guess(states, inputs, None)
 
-def _board_states() -> tuple[int, ...]:
-    robot, _ = skate_models()
-    nr = 12 + robot.n_joints
-    return tuple(range(nr, nr + len(BOARD_STATE)))
+    def rates(metadata: dict[str, Any]) -> ca.Function:
+        robot, board = skate_models(robot_name, board_name)
+        return skate_rates(robot, board)
 
+    def board_states() -> tuple[int, ...]:
+        robot, _ = skate_models(robot_name, board_name)
+        nr = 12 + robot.n_joints
+        return tuple(range(nr, nr + len(BOARD_STATE)))
 
-PAIR = Pair(
-    robot=ROBOT,
-    board=BOARD,
-    default_targets=(0.3, 0.5, 0.7, 1.0),
-    entries=_entries,
-    check=_check,
-    build=_build,
-    guess=_guess,
-    rates=_rates,
-    board_states=_board_states,
-)
+    return Pair(
+        robot=robot_name,
+        board=board_name,
+        default_targets=description.trajopt.default_targets,
+        entries=_entries,
+        check=check,
+        build=build,
+        guess=guess,
+        rates=rates,
+        board_states=board_states,
+    )

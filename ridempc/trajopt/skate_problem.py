@@ -80,7 +80,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-_TRUNK = rigid_body_state_names("trunk")
 
 
 @dataclass(frozen=True)
@@ -90,7 +89,7 @@ class SkateOptions:
     Attributes:
         dt: Grid step [s].
         friction: Foot friction coefficient :math:`\\mu` [-].
-        pusher: Contact site of the pushing foot.
+        pusher: Contact site of the pushing foot (the pair file's ``trajopt.pusher``).
         period: Push period [s] (1.2 s in the paper).
         sweep: Distance the pushing foot sweeps along the ground per push [m].
         speed_per_stride: Speed gained per push, which sets the number of strides [m/s].
@@ -105,12 +104,10 @@ class SkateOptions:
             foot opposite the pusher at 6 N, and the MPC rider let it lift off the deck).
         support_margin: Least horizontal distance of the centre of mass inside the triangle
             of the three feet on the deck while the fourth swings, from its lift-off node to
-            its touchdown node included [m]. Without it the optimum left the centre of mass
-            on the triangle's diagonal when the pushing foot landed (0.5 cm past it in the
-            0.3 m/s entry, 0.1 cm inside in the others: it falls towards that foot, which
-            catches it on time in the plan), and a rider whose trunk tipped
-            a little early fell towards the ground with the foot still in the air: 6 of the
-            64 push-offs of seeds 0-15 fell with those libraries, none with these.
+            its touchdown node included [m]. Without it the optimum leaves the centre of
+            mass on the triangle's diagonal when the pushing foot lands (it falls towards
+            that foot, which catches it on time in the plan), and a rider whose trunk tips a
+            little early falls towards the ground with the foot still in the air.
         torque_fraction: Share of the motor torque limits the stance legs' statics may
             plan [-]. The rest is the whole-body controller's, for the legs' own dynamics
             (massless here) and its feedback: at 1.0 the 1.0 m/s entry planned the pushing
@@ -119,21 +116,12 @@ class SkateOptions:
             each axis, in the grid step before it lands on the ground: it lands nearly still
             (at most ``touchdown_step / dt`` on average over that step, 0.1 m/s) rather
             than at the trunk's speed (1.1 m/s in the 1.0 m/s entry without it), which the
-            massless legs here do not mind and the simulated leg does: push-off-1.0 on
-            seeds 1, 4, 11 and 14 ended 0.020-0.026 m/s faster at 0.01 m than without,
-            and on seeds 1, 4, 6, 10, 11 and 14 0.004-0.011 m/s faster at 0.005 m than at
-            0.01 m (seed 14: 0.874, 0.900, 0.909 m/s).
+            massless legs here do not mind and the simulated leg does: the push-offs end
+            faster, closer to their targets, with it.
         liftoff_force: Largest normal force of the pushing foot on the ground in the grid
             step before it lifts, in units of the weight per foot [-]: the push unloads the
-            foot before lifting it rather than ending at full load. Without it the 1.0 m/s
-            entry's last push ended at 51 N (2.3 weights per foot), and push-off-1.0 seed 18
-            lifted the foot at 31-42 N: the dog dropped onto its front-left foot (74-81 N),
-            the deck tipped to its roll stop with a rear wheel off the ground, a front foot
-            slid off the deck and the ride fell at 7.29 s; seed 27 fell at 7.16 s (of seeds
-            0-31 of the four push-offs, those two fell). At 1.0 (21.8 N) seeds 0-31 of every
-            push-off ride, and end within 7 % of their targets (push-off-1.0 at
-            0.9315-0.9925 m/s, 0.7 at 0.6659-0.7125, where it was 0.9119-0.9970 and
-            0.6344-0.6904).
+            foot before lifting it rather than ending at full load (lifted loaded, the foot
+            drops the dog onto the diagonal foot and tips the deck to its roll stop).
         speed_margin: Board speed bound as a multiple of the target [-].
         start_speed: Speed of the board and rider at the start [m/s]: 0 from rest (an
             ``accelerate`` entry), else a rolling board pushed again (a ``repush`` entry).
@@ -153,7 +141,7 @@ class SkateOptions:
 
     dt: float = 0.05
     friction: float = 0.6
-    pusher: str = "RL_contact"
+    pusher: str = ""
     period: float = 1.2
     sweep: float = 0.2
     speed_per_stride: float = 0.3
@@ -291,7 +279,7 @@ def inward_distances(point: Any, vertices: list[Any], turn: float) -> Any:
 
 
 def _names(robot: RigidBodyRobot) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    states = (*_TRUNK, *(f"q_{j}" for j in robot.joints), *BOARD_STATE)
+    states = (*rigid_body_state_names(robot.base), *(f"q_{j}" for j in robot.joints), *BOARD_STATE)
     forces = tuple(f"f_{foot}_{a}" for foot in robot.feet for a in "xyz")
     return states, (*forces, *(f"qd_{j}" for j in robot.joints))
 
@@ -508,7 +496,7 @@ def build_skate_problem(
         return terms
 
     metadata = {
-        "pair": f"{robot.name}-skateboard",
+        "pair": f"{robot.name}-{board.name}",
         "kind": "repush" if o.start_speed > 0.0 else "accelerate",
         "target": float(target),
         "options": asdict(o),

@@ -26,17 +26,25 @@ model (:mod:`ridempc.boards.skateboard.reduced`) with ``xp = casadi``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import casadi as ca
 
 from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState, canonical_board_states
 from ridempc.boards.skateboard.parameters import SkateboardParameters, SkateboardReducedParameters
 from ridempc.boards.skateboard.reduced import dubins_rates, roll_acceleration
 from ridempc.errors import ConfigError
 from ridempc.trajopt.rotations import rotation_x, rotation_z
 
-__all__ = ["BOARD_STATE", "SkateboardModel", "deck_frame", "skateboard_model", "skateboard_rates"]
+__all__ = [
+    "BOARD_STATE",
+    "DECK_QUANTITIES",
+    "SkateboardModel",
+    "deck_frame",
+    "skateboard_model",
+    "skateboard_rates",
+]
 
 BOARD_STATE: tuple[str, ...] = (
     "board_x",
@@ -46,6 +54,16 @@ BOARD_STATE: tuple[str, ...] = (
     "board_roll",
     "board_roll_rate",
 )
+DECK_PREFIX = "board_"  # the deck's states' prefix in BOARD_STATE
+# What each deck state is, by its canonical name (ridempc.boards.canonical).
+DECK_QUANTITIES: dict[str, str] = {
+    "x": "x",
+    "y": "y",
+    "yaw": "heading",
+    "v": "speed",
+    "roll": "roll",
+    "roll_rate": "roll_rate",
+}
 
 
 @dataclass(frozen=True)
@@ -63,6 +81,7 @@ class SkateboardModel:
         viscous_drag: Viscous rolling resistance :math:`c_v` [N s / m].
         friction_sharpness: :math:`k` of eq. (10) [s / m].
         reduced: The identified roll and steering model.
+        name: The board's name (its description's).
     """
 
     mass: float
@@ -74,6 +93,15 @@ class SkateboardModel:
     viscous_drag: float
     friction_sharpness: float
     reduced: SkateboardReducedParameters
+    name: str
+
+    def platform_prefixes(self) -> tuple[str, ...]:
+        """The deck's prefix of its state names."""
+        return (DECK_PREFIX,)
+
+    def board_states(self) -> dict[str, BoardState]:
+        """Each of :data:`BOARD_STATE` as its canonical quantity (one platform, the deck)."""
+        return canonical_board_states(self.platform_prefixes(), DECK_QUANTITIES)
 
 
 def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> SkateboardModel:
@@ -82,9 +110,9 @@ def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> Skateboa
     Raises:
         ConfigError: The board is not a skateboard or has no identified reduced model.
     """
-    params = board.params
-    if not isinstance(params, SkateboardParameters):
-        raise ConfigError(f"board '{board.name}' is not a skateboard")
+    if "deck_roll" not in board.kind.features:
+        raise ConfigError(f"board '{board.name}' is not a skateboard (no rolling deck)")
+    params = cast(SkateboardParameters, board.params)
     if params.reduced is None:
         raise ConfigError(
             f"{board.folder / 'board.toml'}: no [reduced] table; run `ridempc board identify`"
@@ -100,6 +128,7 @@ def skateboard_model(board: Board, friction_sharpness: float = 20.0) -> Skateboa
         viscous_drag=4.0 * params.wheel_damping / r**2,
         friction_sharpness=friction_sharpness,
         reduced=params.reduced,
+        name=board.name,
     )
 
 

@@ -23,4 +23,5 @@ KIND = BoardKind(
     build=build_hovershoes,
     firmware=make_firmware,
     identify=_identify,
+    features=frozenset({"shoes"}),
 )

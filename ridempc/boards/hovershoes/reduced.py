@@ -41,6 +41,7 @@ from ridempc.boards.hovershoes.parameters import HovershoesReducedParameters
 
 __all__ = [
     "STATE_NAMES",
+    "STATE_QUANTITIES",
     "contact_torques",
     "pitch_acceleration",
     "rollout",
@@ -50,6 +51,17 @@ __all__ = [
 ]
 
 STATE_NAMES: tuple[str, ...] = ("x", "y", "psi", "theta", "theta_dot", "psi_dot", "v")
+# What each state is, by its canonical name (ridempc.boards.canonical): the same quantities
+# every board's reduced model names.
+STATE_QUANTITIES: dict[str, str] = {
+    "x": "x",
+    "y": "y",
+    "psi": "heading",
+    "theta": "pitch",
+    "theta_dot": "pitch_rate",
+    "psi_dot": "yaw_rate",
+    "v": "speed",
+}
 Array = NDArray[np.float64]
 
 

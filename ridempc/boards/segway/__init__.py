@@ -18,6 +18,7 @@ KIND = BoardKind(
     build=build_segway,
     firmware=SegwayFirmware,
     identify=identify,
+    features=frozenset({"knee_bar"}),
 )
 
 __all__ = [

@@ -43,9 +43,20 @@ from numpy.typing import NDArray
 
 from ridempc.boards.segway.parameters import SegwayReducedParameters
 
-__all__ = ["STATE", "INPUT", "segway_dynamics", "simulate_segway"]
+__all__ = ["STATE", "STATE_QUANTITIES", "INPUT", "segway_dynamics", "simulate_segway"]
 
 STATE: tuple[str, ...] = ("x", "y", "psi", "theta", "theta_rate", "speed", "yaw_rate")
+# What each state is, by its canonical name (ridempc.boards.canonical): the same quantities
+# every board's reduced model names.
+STATE_QUANTITIES: dict[str, str] = {
+    "x": "x",
+    "y": "y",
+    "psi": "heading",
+    "theta": "pitch",
+    "theta_rate": "pitch_rate",
+    "speed": "speed",
+    "yaw_rate": "yaw_rate",
+}
 INPUT: tuple[str, ...] = ("u_theta", "knee_bar")
 
 

@@ -24,4 +24,5 @@ KIND = BoardKind(
     build=build_skateboard,  # type: ignore[arg-type]
     firmware=make_firmware,
     identify=identify,
+    features=frozenset({"deck_roll"}),
 )
