@@ -1,0 +1,209 @@
+"""Handing the ride to a backup balance law and back, with the motor commands blended.
+
+A tracking controller (the MPC rider) rides while its plans and whole-body QPs solve and
+its state stays near its reference. When one of them fails, the ride is handed to a
+*backup* law that balances the same robot on the same board from the same sensors (the
+pair's PD baseline, :data:`ridempc.controllers.registry.CONTROLLERS`), and handed back
+once the tracking controller has been *fit* again for :data:`RETURN_DWELL_S` (doubled at
+each further handover, :meth:`Handover.dwell`):
+
+.. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
+          \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
+
+over every field of the motor command (feedforward torque, targets and gains). The backup
+runs at every tick (hot standby): its estimator, filters and integrators are current at
+the moment it takes over, and its nominal posture is the one it took at the ride's
+start, as when it rides alone.
+
+Nothing here names a robot, a board or a law: :class:`Handover` takes the backup as a
+:class:`~ridempc.controllers.base.Controller` and is told, each tick, the primary's
+command (or None), why it failed (or None) and whether it is fit to ride.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.controllers.base import Controller
+from ridempc.scenarios.scenario import Command
+from ridempc.sim.motors import MotorCommand
+from ridempc.sim.sensors import SensorPacket
+
+__all__ = [
+    "BLEND_S",
+    "HANDOVER_DEVIATION",
+    "RETURN_DEVIATION",
+    "RETURN_DWELL_S",
+    "Fallback",
+    "Handover",
+    "blend",
+    "deviation",
+]
+
+# [s] the blend of the two laws' commands: 10 ticks at 500 Hz. A step of the feedforward
+# torques between two laws kicks the legs' stance modes (their periods are 30-60 ms with
+# the board under the feet), so the step is spread over about half a period; and a failed
+# law's last command is out of the loop before the rider has tipped by a degree.
+BLEND_S: float = 0.02
+# [s] how long the primary must be fit before it rides again: the hysteresis that keeps a
+# rider at the edge of the primary's region from handing over every few ticks; 0.5 s is
+# about one period of a standing rider's sway on a board, so one swing back through the
+# region does not count.
+RETURN_DWELL_S: float = 0.5
+# [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
+# beyond which its linear model no longer holds and the ride is handed over: 1.8 times the
+# largest the MPC reached over the library's manoeuvres (1.67, Hovershoes velocity-steps).
+HANDOVER_DEVIATION: float = 3.0
+# [-] the same error below which the primary may ride again: a third of the handover's,
+# the band between them the hysteresis (a standing rider's own sway stays within 1).
+RETURN_DEVIATION: float = 1.0
+# [s] times within this are equal: a tick's time carries the rounding of its sum
+TIME_TOLERANCE: float = 1e-9
+
+
+@dataclass
+class Fallback:
+    """One handover to the backup.
+
+    Attributes:
+        time_s: When it began [s].
+        reason: Why the primary could not ride.
+        duration_s: How long the backup rode [s]; None while it still rides.
+    """
+
+    time_s: float
+    reason: str
+    duration_s: float | None = None
+
+    def record(self) -> dict[str, Any]:
+        """For ``summary.json``."""
+        return {"time_s": self.time_s, "reason": self.reason, "duration_s": self.duration_s}
+
+
+def blend(start: MotorCommand, end: MotorCommand, alpha: float) -> MotorCommand:
+    """:math:`(1 - \\alpha)\\, start + \\alpha\\, end`, field by field."""
+    if alpha >= 1.0:
+        return end
+    a, b = 1.0 - alpha, alpha
+    return MotorCommand(
+        torque=a * start.torque + b * end.torque,
+        position=a * start.position + b * end.position,
+        velocity=a * start.velocity + b * end.velocity,
+        kp=a * start.kp + b * end.kp,
+        kd=a * start.kd + b * end.kd,
+    )
+
+
+class Handover:
+    """Which law rides, and the blend between them.
+
+    Args:
+        backup: The backup law, run at every tick.
+        blend_s: :math:`T_{blend}` [s].
+        dwell_s: How long the primary must be fit before it rides again [s].
+
+    Attributes:
+        fallbacks: Every handover so far, in order.
+    """
+
+    def __init__(
+        self, backup: Controller, blend_s: float = BLEND_S, dwell_s: float = RETURN_DWELL_S
+    ) -> None:
+        self.backup = backup
+        self.blend_s = blend_s
+        self.dwell_s = dwell_s
+        self.fallbacks: list[Fallback] = []
+        self._switch_time: float | None = None  # [s] the last switch, either way
+        self._from: MotorCommand | None = None  # the command blended out of since then
+        self._fit_since: float | None = None
+        self._last_primary: MotorCommand | None = None
+
+    def dwell(self) -> float:
+        """How long the primary must be fit before it rides again [s]: :attr:`dwell_s`,
+        doubled at each handover after the first, so that a primary that keeps failing
+        (a model error it cannot absorb) rides less and less."""
+        return self.dwell_s * 2.0 ** max(len(self.fallbacks) - 1, 0)
+
+    @property
+    def on_backup(self) -> bool:
+        """Whether the backup rides."""
+        return bool(self.fallbacks) and self.fallbacks[-1].duration_s is None
+
+    def step(
+        self,
+        sensors: SensorPacket,
+        command: Command,
+        primary: MotorCommand | None,
+        failure: str | None,
+        fit: bool,
+    ) -> MotorCommand:
+        """One tick: the backup updated, the handover decided, the command to send.
+
+        Args:
+            sensors: This tick's packet (for the backup).
+            command: The ride's command (for the backup).
+            primary: The primary's command this tick, None where it has none.
+            failure: Why the primary cannot ride this tick, None if it can.
+            fit: Whether the primary is fit to ride again (plans and QPs solving, the state
+                near its reference); read only while the backup rides.
+        """
+        now = sensors.time
+        backup = self.backup.update(sensors, command)
+        if not self.on_backup:
+            if failure is None and primary is not None:
+                self._last_primary = primary
+                return self._blended(now, primary)
+            start = primary if primary is not None else self._last_primary
+            self.fallbacks.append(Fallback(now, failure or "no command"))
+            self._switch(now, start if start is not None else backup)
+            self._fit_since = None
+            return self._blended(now, backup)
+        if failure is None and primary is not None and fit:
+            self._fit_since = now if self._fit_since is None else self._fit_since
+            if now - self._fit_since >= self.dwell() - TIME_TOLERANCE:
+                current = self.fallbacks[-1]
+                current.duration_s = now - current.time_s
+                self._switch(now, self._blended(now, backup))
+                self._last_primary = primary
+                return self._blended(now, primary)
+        else:
+            self._fit_since = None
+        return self._blended(now, backup)
+
+    def _switch(self, now: float, start: MotorCommand) -> None:
+        self._switch_time, self._from = now, start
+
+    def _blended(self, now: float, target: MotorCommand) -> MotorCommand:
+        """``target``, blended in from the last switch's command over :attr:`blend_s`."""
+        if self._switch_time is None or self._from is None:
+            return target
+        elapsed = now - self._switch_time + TIME_TOLERANCE
+        alpha = elapsed / self.blend_s if self.blend_s > 0.0 else 1.0
+        if alpha >= 1.0:
+            self._switch_time = self._from = None
+            return target
+        return blend(self._from, target, max(alpha, 0.0))
+
+    def summary(self) -> list[dict[str, Any]]:
+        """Every handover, for ``summary.json``'s ``fallbacks``."""
+        return [f.record() for f in self.fallbacks]
+
+
+def deviation(
+    state: NDArray[np.float64], reference: NDArray[np.float64], weights: NDArray[np.float64]
+) -> float:
+    """How far ``state`` is from ``reference``, in units of what the weights accept: with
+    each state's weight the inverse square of its acceptable error,
+    :math:`Q_i = 1/\\sigma_i^2` (Bryson's rule, as the MPC's weights are set),
+
+    .. math:: d = \\sqrt{\\tfrac1n \\textstyle\\sum_i Q_i (x_i - x^{ref}_i)^2}
+
+    [-], the root mean square over the :math:`n` states: :math:`d \\le 1` is the states
+    within their acceptable errors on the whole.
+    """
+    squared = np.maximum(weights, 0.0) * (state - reference) ** 2
+    return float(np.sqrt(np.mean(squared))) if squared.size else 0.0
