@@ -91,3 +91,42 @@ def test_the_dwell_doubles_at_each_further_handover() -> None:
     _run(handover, 200, 100, range(110, 111))
     assert len(handover.summary()) == 2 and handover.dwell() == pytest.approx(0.2)
     assert handover.summary()[1]["duration_s"] == pytest.approx(0.202)  # one tick, the dwell
+
+
+def test_in_standby_the_backup_runs_on_its_first_tick_then_every_nth() -> None:
+    backup = _Backup()
+    handover = Handover(backup, standby_every=15)  # type: ignore[arg-type]
+    _run(handover, 45, 0, range(0))
+    assert backup.ticks == 1 + 3  # tick 0, then 7, 22 and 37
+    _run(handover, 20, 45, range(50, 51))  # from the failure on, every tick
+    assert backup.ticks == 4 + 15  # none in standby at 45-49, then every tick of 50-64
+
+
+class _Estimator:
+    """A stand-in estimator: its state, and how often it was reset and updated."""
+
+    def __init__(self, q: float) -> None:
+        self.state = SimpleNamespace(q=np.array([q]), v=np.zeros(1))
+        self.resets = self.updates = 0
+
+    def reset(self, packet: Any) -> Any:
+        self.resets += 1
+        return self.state
+
+    def update(self, packet: Any) -> Any:
+        self.updates += 1
+        return self.state
+
+
+def test_a_shared_estimate_is_read_and_left_for_the_own_filter_when_not_finite() -> None:
+    from ridempc.mpc.handover import SharedEstimate
+
+    primary, own = _Estimator(1.0), _Estimator(2.0)
+    shared = SharedEstimate(primary, own)  # type: ignore[arg-type]
+    assert shared.reset(None).q[0] == 1.0 and shared.update(None).q[0] == 1.0  # type: ignore[arg-type, union-attr]
+    assert primary.updates == primary.resets == own.updates == own.resets == 0
+    primary.state.q[0] = np.nan
+    assert shared.update(None).q[0] == 2.0 and own.resets == 1  # type: ignore[arg-type, union-attr]
+    primary.state.q[0] = 1.0  # once left, the own filter runs on
+    assert shared.update(None).q[0] == 2.0 and own.updates == 1  # type: ignore[arg-type, union-attr]
+    assert shared.detached and shared.state.q[0] == 2.0  # type: ignore[union-attr]

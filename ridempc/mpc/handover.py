@@ -11,9 +11,13 @@ each further handover, :meth:`Handover.dwell`):
           \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
 
 over every field of the motor command (feedforward torque, targets and gains). The backup
-runs at every tick (hot standby): its estimator, filters and integrators are current at
-the moment it takes over, and its nominal posture is the one it took at the ride's
+runs beside the primary (hot standby): its estimator, filters and integrators are current
+at the moment it takes over, and its nominal posture is the one it took at the ride's
 start, as when it rides alone.
+
+The standby costs the backup's tick at every tick; most of it is its state estimator, the
+same filter on the same sensors as the primary's where both see the same platforms, so
+there it reads the primary's estimate instead (:func:`share_estimator`).
 
 Nothing here names a robot, a board or a law: :class:`Handover` takes the backup as a
 :class:`~ridempc.controllers.base.Controller` and is told, each tick, the primary's
@@ -29,12 +33,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.controllers.base import Controller
+from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 
 __all__ = [
     "BLEND_S",
+    "STANDBY_DIVIDER",
+    "SharedEstimate",
     "HANDOVER_DEVIATION",
     "RETURN_DEVIATION",
     "RETURN_DWELL_S",
@@ -42,6 +49,7 @@ __all__ = [
     "Handover",
     "blend",
     "deviation",
+    "share_estimator",
 ]
 
 # [s] the blend of the two laws' commands: 10 ticks at 500 Hz. A step of the feedforward
@@ -61,6 +69,11 @@ HANDOVER_DEVIATION: float = 3.0
 # [-] the same error below which the primary may ride again: a third of the handover's,
 # the band between them the hysteresis (a standing rider's own sway stays within 1).
 RETURN_DEVIATION: float = 1.0
+# [ticks] the backup's standby rate while the primary rides, where it reads the primary's
+# estimate (SharedEstimate): every 15th tick (33 Hz at 500 Hz). Its filters, integrators and
+# rate limits step by the sample times, so they stay current; the first tick (where it takes
+# its nominal posture) and every tick from a handover on run it in full.
+STANDBY_DIVIDER: int = 15
 # [s] times within this are equal: a tick's time carries the rounding of its sum
 TIME_TOLERANCE: float = 1e-9
 
@@ -102,18 +115,28 @@ class Handover:
     """Which law rides, and the blend between them.
 
     Args:
-        backup: The backup law, run at every tick.
+        backup: The backup law.
         blend_s: :math:`T_{blend}` [s].
         dwell_s: How long the primary must be fit before it rides again [s].
+        standby_every: While the primary rides, the backup runs at every this many ticks
+            (1: every tick, as it must with an estimator of its own); half a period after
+            the first, off the ticks a primary with a slower loop of its own starts from.
 
     Attributes:
         fallbacks: Every handover so far, in order.
     """
 
     def __init__(
-        self, backup: Controller, blend_s: float = BLEND_S, dwell_s: float = RETURN_DWELL_S
+        self,
+        backup: Controller,
+        blend_s: float = BLEND_S,
+        dwell_s: float = RETURN_DWELL_S,
+        standby_every: int = 1,
     ) -> None:
         self.backup = backup
+        self.standby_every = standby_every
+        self._ticks = 0
+        self._backup_command: MotorCommand | None = None
         self.blend_s = blend_s
         self.dwell_s = dwell_s
         self.fallbacks: list[Fallback] = []
@@ -152,7 +175,7 @@ class Handover:
                 near its reference); read only while the backup rides.
         """
         now = sensors.time
-        backup = self.backup.update(sensors, command)
+        backup = self._backup(sensors, command, primary is None or failure is not None)
         if not self.on_backup:
             if failure is None and primary is not None:
                 self._last_primary = primary
@@ -173,6 +196,22 @@ class Handover:
         else:
             self._fit_since = None
         return self._blended(now, backup)
+
+    def _backup(self, sensors: SensorPacket, command: Command, needed: bool) -> MotorCommand:
+        """The backup's command: run this tick where it rides, is blended or ``needed``, on
+        its first tick, and every :attr:`standby_every` ticks in standby."""
+        tick, self._ticks = self._ticks, self._ticks + 1
+        every = self.standby_every
+        standby = tick % every == every // 2 if every > 1 else True
+        if (
+            self._backup_command is None
+            or needed
+            or standby
+            or self.on_backup
+            or self._switch_time is not None
+        ):
+            self._backup_command = self.backup.update(sensors, command)
+        return self._backup_command
 
     def _switch(self, now: float, start: MotorCommand) -> None:
         self._switch_time, self._from = now, start
@@ -207,3 +246,56 @@ def deviation(
     """
     squared = np.maximum(weights, 0.0) * (state - reference) ** 2
     return float(np.sqrt(np.mean(squared))) if squared.size else 0.0
+
+
+class SharedEstimate:
+    """A backup's stand-in for its state estimator: the primary's estimator, updated by the
+    primary each tick before the backup runs, which ``reset`` and ``update`` only read;
+    where the primary's estimate is not finite (a diverged filter, a sensor fault), the
+    backup's own estimator restarts from that packet and runs on alone from then on.
+
+    Args:
+        estimator: The primary's estimator.
+        own: The backup's own estimator (the same filter), idle while shared.
+    """
+
+    def __init__(self, estimator: StateEstimator, own: StateEstimator) -> None:
+        self._estimator = estimator
+        self._own = own
+        self.detached = False
+
+    @property
+    def state(self) -> EstimatedState | None:
+        return (self._own if self.detached else self._estimator).state
+
+    def reset(self, packet: SensorPacket, *args: Any, **kwargs: Any) -> EstimatedState | None:
+        return self.update(packet)
+
+    def update(self, packet: SensorPacket) -> EstimatedState | None:
+        if self.detached:
+            return self._own.update(packet)
+        state = self._estimator.state
+        if state is not None and np.isfinite(state.q).all() and np.isfinite(state.v).all():
+            return state
+        self.detached = True
+        return self._own.reset(packet)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._own if self.detached else self._estimator, name)
+
+
+def share_estimator(backup: Controller, estimator: StateEstimator) -> bool:
+    """Give ``backup`` the primary's ``estimator`` in place of its own
+    (:class:`SharedEstimate`), where its own is the same filter (the same robot,
+    platforms and support height); returns whether it did."""
+    own = getattr(backup, "estimator", None)
+    if not isinstance(own, StateEstimator):
+        return False
+    same = (
+        own.robot is estimator.robot
+        and own.platforms == estimator.platforms
+        and own.support_height == estimator.support_height
+    )
+    if same:
+        backup.estimator = SharedEstimate(estimator, own)  # type: ignore[attr-defined]
+    return same

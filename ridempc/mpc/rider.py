@@ -67,9 +67,11 @@ Every 2 ms (500 Hz) the rider
 has no solution as posed, :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its
 previous plan shifted by one step is then used), the whole-body QP needs slack or still
 fails, anything raises, or the estimate is not finite, the ride is handed to the pair's PD
-baseline (:data:`BACKUP_LAW`, run at every tick beside the MPC), the motor commands
-blended, and handed back once the MPC's plans have solved for a while
-(:mod:`ridempc.mpc.handover`); each handover is in ``summary()``'s ``fallbacks``. Only
+baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's estimate),
+the motor commands blended, and handed back once the MPC's plans have solved and its state
+has stayed near the reference for a while (:mod:`ridempc.mpc.handover`); the same happens
+where the state strays beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its
+reference; each handover is in ``summary()``'s ``fallbacks``. Only
 where the backup too has no finite command are the joints held where they are
 (``safe_hold``).
 """
@@ -97,7 +99,14 @@ from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
-from ridempc.mpc.handover import HANDOVER_DEVIATION, RETURN_DEVIATION, Handover, deviation
+from ridempc.mpc.handover import (
+    HANDOVER_DEVIATION,
+    RETURN_DEVIATION,
+    STANDBY_DIVIDER,
+    Handover,
+    deviation,
+    share_estimator,
+)
 from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -402,7 +411,9 @@ class MpcRider(Controller):
         self._wbc_ms: list[float] = []
         self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
-        self.handover = Handover(backup if backup is not None else _backup(robot, board))
+        law = backup if backup is not None else _backup(robot, board)
+        shared = share_estimator(law, self.estimator)  # one filter for both
+        self.handover = Handover(law, standby_every=STANDBY_DIVIDER if shared else 1)
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
