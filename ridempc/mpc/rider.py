@@ -66,14 +66,13 @@ Every 2 ms (500 Hz) the rider
 **Fallback.** The whole-body QP always returns a command (slack on its soft rows where it
 has no solution as posed, :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its
 previous plan shifted by one step is then used), the whole-body QP needs slack or still
-fails, anything raises, or the estimate is not finite, the ride is handed to the pair's PD
-baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's estimate),
-the motor commands blended, and handed back once the MPC's plans have solved and its state
-has stayed near the reference for a while (:mod:`ridempc.mpc.handover`); the same happens
-where the state strays beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its
-reference; each handover is in ``summary()``'s ``fallbacks``. Only
-where the backup too has no finite command are the joints held where they are
-(``safe_hold``).
+fails, anything raises, the estimate is not finite, or the state strays beyond
+:data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, the ride is handed to
+the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
+estimate), the motor commands blended, and handed back once the MPC's plans have solved
+and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
+each handover is in ``summary()``'s ``fallbacks``. Only where the backup too has no
+finite command are the joints held where they are (``safe_hold``).
 """
 
 from __future__ import annotations
