@@ -15,9 +15,10 @@ runs beside the primary (hot standby): its estimator, filters and integrators ar
 at the moment it takes over, and its nominal posture is the one it took at the ride's
 start, as when it rides alone.
 
-The standby costs the backup's tick at every tick; most of it is its state estimator, the
-same filter on the same sensors as the primary's where both see the same platforms, so
-there it reads the primary's estimate instead (:func:`share_estimator`).
+The standby would cost the backup's whole tick at every tick. Most of that is its state
+estimator, the same filter on the same sensors as the primary's where both see the same
+platforms: there it reads the primary's estimate instead (:func:`share_estimator`), and
+runs in standby only every :data:`STANDBY_DIVIDER` ticks.
 
 Nothing here names a robot, a board or a law: :class:`Handover` takes the backup as a
 :class:`~ridempc.controllers.base.Controller` and is told, each tick, the primary's
@@ -40,13 +41,13 @@ from ridempc.sim.sensors import SensorPacket
 
 __all__ = [
     "BLEND_S",
-    "STANDBY_DIVIDER",
-    "SharedEstimate",
     "HANDOVER_DEVIATION",
     "RETURN_DEVIATION",
     "RETURN_DWELL_S",
+    "STANDBY_DIVIDER",
     "Fallback",
     "Handover",
+    "SharedEstimate",
     "blend",
     "deviation",
     "share_estimator",
@@ -63,11 +64,13 @@ BLEND_S: float = 0.02
 # region does not count.
 RETURN_DWELL_S: float = 0.5
 # [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
-# beyond which its linear model no longer holds and the ride is handed over: 1.8 times the
-# largest the MPC reached over the library's manoeuvres (1.67, Hovershoes velocity-steps).
+# beyond which its linear model no longer holds and the ride is handed over: 1.7 times the
+# largest the MPC reached in the library's manoeuvres (1.40-1.75: Segway push and
+# velocity-steps, Hovershoes velocity-steps, skateboard push-off-0.5, seed 0).
 HANDOVER_DEVIATION: float = 3.0
 # [-] the same error below which the primary may ride again: a third of the handover's,
-# the band between them the hysteresis (a standing rider's own sway stays within 1).
+# the band between them the hysteresis (standing still on the Hovershoes it sits at
+# 0.55-0.67 once settled).
 RETURN_DEVIATION: float = 1.0
 # [ticks] the backup's standby rate while the primary rides, where it reads the primary's
 # estimate (SharedEstimate): every 15th tick (33 Hz at 500 Hz). Its filters, integrators and
