@@ -1,4 +1,4 @@
-"""``mpc``: the MPC/WBC rider in MuJoCo, a short ride, its safe hold and bad input."""
+"""``mpc``: the MPC/WBC rider in MuJoCo, a short ride, its handover to the PD and bad input."""
 
 from __future__ import annotations
 
@@ -12,8 +12,9 @@ import pytest
 from ridempc.boards import load_board
 from ridempc.cli import main
 from ridempc.estimation import BoardEstimate, EstimatedState
+from ridempc.mpc.handover import RETURN_DWELL_S
 from ridempc.mpc.pairs import load_mpc_pair
-from ridempc.mpc.rider import MPC_DIVIDER, WBC_GRACE_TICKS, MpcRider
+from ridempc.mpc.rider import MPC_DIVIDER, MpcRider
 from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S, StateMap
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -85,30 +86,36 @@ def test_stands_on_the_skateboard(tmp_path) -> None:
     assert summary["estimator_velocity_rmse"] < 0.05
 
 
-def test_a_wbc_that_keeps_failing_ends_in_a_safe_hold_that_the_summary_explains(dog) -> None:
-    rider = MpcRider(dog, "skateboard")
-    solve = rider.wbc.solve
+def test_a_failing_wbc_hands_the_ride_to_the_pd_and_back(dog, tmp_path, monkeypatch) -> None:
+    """The whole-body QP fails from 0.3 to 0.5 s (a test hook in place of the solver): the
+    ride goes to the pair's PD at the first failure, blended, never frozen, and back to the
+    MPC once its QPs have solved for ``RETURN_DWELL_S``; ``summary.json`` records it."""
+    from ridempc.wbc.controller import WholeBodyController
 
-    def failing(state, targets):
-        if state.time > 0.5:
-            raise WbcFailed("primal infeasible", rider.wbc.last_problem)
-        return solve(state, targets)
+    solve = WholeBodyController.solve
 
-    rider.wbc.solve = failing
-    result, rider = _ride(dog, 1.0, rider)
-    assert result.status == "ok"  # held, not crashed
-    hold = rider.summary()["safe_hold"]
-    assert hold is not None and "WbcFailed" in hold["reason"]
-    grace = 0.002 * WBC_GRACE_TICKS  # the last command bridges a few failed ticks first
-    assert 0.5 + grace <= hold["time_s"] < 0.51 + grace
-    assert rider.summary()["wbc_failures"] == WBC_GRACE_TICKS
-    joints = result.log["qpos"][:, 7:]
-    assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # holds its joints
+    def failing(self, state, targets):
+        if 0.3 <= state.time < 0.5:
+            raise WbcFailed("primal infeasible", self.last_problem)
+        return solve(self, state, targets)
+
+    monkeypatch.setattr(WholeBodyController, "solve", failing)
+    out = tmp_path / "ride"
+    args = ["sim", "--robot", "cyberdog2", "--board", "skateboard", "--controller", "mpc"]
+    assert main([*args, "--duration", "1.2", "--no-plots", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "ok" and not summary["fell"]
+    assert summary["safe_hold"] is None
+    (fallback,) = summary["fallbacks"]
+    assert 0.3 <= fallback["time_s"] < 0.303 and "WbcFailed" in fallback["reason"]
+    back = 0.5 + RETURN_DWELL_S - 0.3  # the first solved QP, then the dwell
+    assert fallback["duration_s"] == pytest.approx(back, abs=0.01)
 
 
-def test_a_state_estimate_gone_non_finite_ends_in_a_safe_hold(dog) -> None:
+def test_a_state_estimate_gone_non_finite_hands_the_ride_to_the_pd(dog) -> None:
     """A NaN in the estimate (a sensor fault, a diverged filter) never reaches the MPC or
-    the WBC: the rider holds its joints from that tick, and the summary says when and why."""
+    the WBC: the PD, with its own estimator, rides on from that tick, and the summary says
+    when and why."""
     rider = MpcRider(dog, "skateboard")
     update = rider.estimator.update
 
@@ -121,18 +128,20 @@ def test_a_state_estimate_gone_non_finite_ends_in_a_safe_hold(dog) -> None:
         return state
 
     rider.estimator.update = faulty
-    result, rider = _ride(dog, 1.0, rider)
-    assert result.status == "ok" and not result.fell  # held, not crashed
-    hold = rider.summary()["safe_hold"]
-    assert hold is not None and "state estimate not finite" in hold["reason"]
-    assert 0.5 <= hold["time_s"] < 0.503
+    result, rider = _ride(dog, 1.2, rider)
+    assert result.status == "ok" and not result.fell
+    summary = rider.summary()
+    assert summary["safe_hold"] is None
+    (fallback,) = summary["fallbacks"]
+    assert fallback["reason"] == "state estimate not finite"
+    assert 0.5 <= fallback["time_s"] < 0.503 and fallback["duration_s"] is None
     joints = result.log["qpos"][:, 7:]
-    assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # holds its joints
+    assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # still balancing
 
 
-def test_a_corrupt_library_entry_met_mid_ride_ends_in_a_safe_hold(dog, tmp_path, monkeypatch):
+def test_a_corrupt_library_entry_met_mid_ride_hands_the_ride_to_the_pd(dog, tmp_path, monkeypatch):
     """push-off-0.5 picks up accelerate-0.50 when the command comes (0.5 s); with that file
-    corrupt, the rider holds, and the summary names the file."""
+    corrupt, the PD rides on, and the summary names the file."""
     import shutil
 
     import ridempc.mpc.reference as reference
@@ -146,10 +155,12 @@ def test_a_corrupt_library_entry_met_mid_ride_ends_in_a_safe_hold(dog, tmp_path,
     scenario = resolve_scenario("push-off-0.5", "skateboard").with_duration(1.0)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
     result = Simulation(scene, rider, scenario).run()
-    assert result.status == "ok" and not result.fell  # held, not crashed
-    hold = rider.summary()["safe_hold"]
-    assert hold is not None and "accelerate-0.50.npz" in hold["reason"]
-    assert 0.5 <= hold["time_s"] < 0.55
+    assert result.status == "ok" and not result.fell
+    summary = rider.summary()
+    assert summary["safe_hold"] is None
+    fallback = summary["fallbacks"][0]
+    assert "accelerate-0.50.npz" in fallback["reason"]
+    assert 0.5 <= fallback["time_s"] < 0.55
 
 
 def test_a_pair_without_an_mpc_is_refused(tmp_path, capsys) -> None:

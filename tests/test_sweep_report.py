@@ -13,7 +13,9 @@ HEADER = {"robot": "cassie", "board": "hovershoes", "scenario": "stand-still",
           "distribution": "everyday", "seed": 0, "duration": None}  # fmt: skip
 
 
-def _results(pd_falls: set[int], mpc_falls: set[int], n: int = 10) -> dict:
+def _results(
+    pd_falls: set[int], mpc_falls: set[int], n: int = 10, handed: frozenset[int] = frozenset()
+) -> dict:
     variants = [
         {"id": f"v{i:04d}", "seed": 100 + i, "drawn": {"push.magnitude": 0.1 * i},
          "scenario_file": f"variants/v{i:04d}.toml"}
@@ -28,6 +30,9 @@ def _results(pd_falls: set[int], mpc_falls: set[int], n: int = 10) -> dict:
                 "fall_time_s": 2.0 + i if fell else None, "velocity_rmse": 0.01 * (i + 1),
                 "worker_peak_rss_mib": 300.0,
             }  # fmt: skip
+            if c == "mpc" and i in handed:  # handed to the PD once, or twice for i = 3
+                fallback = {"time_s": 1.0, "reason": "WbcFailed: ...", "duration_s": 0.6}
+                summaries[(v["id"], c)]["fallbacks"] = [fallback] * (2 if i == 3 else 1)
     return sweep_results(HEADER, variants, ["pd", "mpc"], summaries)
 
 
@@ -65,3 +70,13 @@ def test_worst_rides_name_the_draws_furthest_in_the_tails() -> None:
     assert all(len(names) == EXTREME_DRAWS for names in named.values())
     assert set(named["v9"][:2]) == {"a 9 (top 5 %)", "b -9 (bottom 5 %)"}  # the extremes
     assert not any(name.startswith("c ") for names in named.values() for name in names)
+
+
+def test_fallbacks_are_counted_and_reported(tmp_path: Path) -> None:
+    results = _results(set(), {8}, handed=frozenset({1, 3, 8}))
+    mpc = results["controllers"]["mpc"]
+    assert (mpc["fallback_rides"], mpc["fallbacks"]) == (3, 4)
+    assert results["controllers"]["pd"]["fallbacks"] == 0
+    write_report(results, tmp_path)
+    assert "| mpc | 9/10 | 90.0% |" in (tmp_path / "report.md").read_text()
+    assert "3 rides (4)" in (tmp_path / "report.md").read_text()

@@ -420,18 +420,22 @@ def test_daqp_as_the_solver_finds_osqps_polished_optimum(robot) -> None:
         WbcSettings(solver="qpoases")
 
 
-def test_daqp_as_the_solver_fails_with_its_own_flag() -> None:
+def test_daqp_as_the_solver_gives_way_on_the_soft_rows() -> None:
+    """2 kN on every foot cannot be held with 12 N m motors: the friction rows take a
+    slack (:mod:`ridempc.wbc.elastic`), the torque limits hold."""
     robot = load_robot("cyberdog2")
     settings = WbcSettings(min_normal_force=2000.0, max_normal_force=100, solver="daqp")
     wbc = WholeBodyController(robot, settings)
     estimator = StateEstimator(robot, pinocchio=wbc.model.pinocchio)
     q, v = _standing(robot, estimator, np.random.default_rng(3))
-    with pytest.raises(WbcFailed, match="whole-body QP failed: DAQP exit flag -") as info:
-        wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool)))
-    assert "OSQP" not in str(info.value)
+    out = wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool)))
+    assert out.status == "solved with slack" and wbc.qp.elastic_solves == 1
+    assert wbc.last_solution is not None and wbc.last_solution.slack > 100.0  # [N]
+    limits = TorqueSpeedCurve.of(robot.motors).limit(v[wbc.motor_v])
+    assert np.all(np.abs(out.torque) <= limits + 1e-6)
 
 
-def test_infeasible_qp_is_retried_cold_then_by_daqp_then_raises_wbc_failed() -> None:
+def test_infeasible_qp_is_retried_cold_then_by_daqp_then_with_slack() -> None:
     robot = load_robot("cyberdog2")
     # 2 kN on every foot cannot be held with 12 N m motors
     settings = WbcSettings(min_normal_force=2000.0, max_normal_force=100, solver="osqp")
@@ -440,13 +444,18 @@ def test_infeasible_qp_is_retried_cold_then_by_daqp_then_raises_wbc_failed() -> 
     q, v = _standing(robot, estimator, np.random.default_rng(3))
     wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.zeros(4, dtype=bool)))  # in flight: fine
     assert wbc.qp.setups == 1 and wbc.qp.cold_retries == 0
+    out = wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool)))
+    assert wbc.qp.cold_retries == 1 and wbc.qp.setups == 2  # the warm failure retried cold
+    assert wbc.qp.fallbacks == 0  # DAQP: infeasible too
+    assert out.status == "solved with slack" and wbc.qp.elastic_solves == 1
+    problem = wbc.last_problem
+    assert problem is not None
     with pytest.raises(WbcFailed, match="infeasible|maximum iterations") as info:
-        wbc.solve(_state(wbc, q, v), _targets(wbc, q, v, np.ones(4, dtype=bool)))
+        wbc.qp._solve_hard(problem, 0.0)  # as it is, without the slack
     assert isinstance(info.value, RidempcError)
     assert info.value.problem.A.shape[1] == wbc.model.layout.size
-    assert wbc.qp.cold_retries == 1 and wbc.qp.setups == 2  # the warm failure retried cold
-    assert info.value.daqp_flag is not None and info.value.daqp_flag < 1  # DAQP: infeasible too
-    assert "DAQP exit flag" in str(info.value) and wbc.qp.fallbacks == 0
+    assert info.value.daqp_flag is not None and info.value.daqp_flag < 1
+    assert "DAQP exit flag" in str(info.value)
 
 
 def test_a_qp_osqp_cannot_solve_goes_to_daqp() -> None:

@@ -63,11 +63,16 @@ Every 2 ms (500 Hz) the rider
    posture (:func:`~ridempc.robots.delay_margin.tracking_damping`), the others' the same
    scale of their default damping.
 
-**Safe hold.** If the MPC fails, the previous plan shifted by one step is used (the QP's
-fallback, counted); if the WBC fails, its last command is sent again for up to
-``WBC_GRACE_TICKS`` ticks (counted); if the estimate is not finite, the WBC keeps failing or
-anything raises, the rider holds its joints where they are with the robot's default gains
-from then on, and its ``summary()`` says why and when.
+**Fallback.** The whole-body QP always returns a command (slack on its soft rows where it
+has no solution as posed, :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its
+previous plan shifted by one step is then used), the whole-body QP needs slack or still
+fails, anything raises, the estimate is not finite, or the state strays beyond
+:data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, the ride is handed to
+the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
+estimate), the motor commands blended, and handed back once the MPC's plans have solved
+and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
+each handover is in ``summary()``'s ``fallbacks``. Only where the backup too has no
+finite command are the joints held where they are (``safe_hold``).
 """
 
 from __future__ import annotations
@@ -93,6 +98,14 @@ from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
+from ridempc.mpc.handover import (
+    HANDOVER_DEVIATION,
+    RETURN_DEVIATION,
+    STANDBY_DIVIDER,
+    Handover,
+    deviation,
+    share_estimator,
+)
 from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -135,13 +148,13 @@ from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.settings import WbcSettings
 from ridempc.wbc.torque_lead import TorqueLead
 
-__all__ = ["MpcRider", "platform_feet", "rolling_platforms"]
+__all__ = ["BACKUP_LAW", "MpcRider", "platform_feet", "rolling_platforms"]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
-# Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
-# QP that does not converge should not end a ride (the QP already retried it cold).
-WBC_GRACE_TICKS: int = 5
+# The law the ride is handed to when the MPC or its QP fails (ridempc.mpc.handover): the
+# pair's PD baseline, which balances every pair from the same sensors.
+BACKUP_LAW: str = "pd"
 
 
 class _PendingSolve(NamedTuple):
@@ -156,6 +169,13 @@ class _PendingSolve(NamedTuple):
     due: int
     build_s: float
     future: Future[SolveOutcome] | None = None
+
+
+def _backup(robot: Robot, board: str) -> Controller:
+    """The registry's :data:`BACKUP_LAW` for ``robot`` on ``board``."""
+    from ridempc.controllers.registry import CONTROLLERS  # the registry imports this module
+
+    return CONTROLLERS[BACKUP_LAW](robot, board)
 
 
 @cache
@@ -210,6 +230,9 @@ class MpcRider(Controller):
         settings: MPC settings.
         wbc_solver: The whole-body QP's solver (:data:`~ridempc.wbc.settings.SOLVERS`);
             None: the registry's (:data:`~ridempc.solvers.QP_KINDS`).
+        backup: The law the ride is handed to when the MPC fails
+            (:mod:`~ridempc.mpc.handover`); None: the registry's :data:`BACKUP_LAW` for
+            the pair.
 
     Raises:
         UnknownNameError: No MPC for this robot-board pair.
@@ -225,6 +248,7 @@ class MpcRider(Controller):
         settings: MpcSettings | None = None,
         wbc_solver: str | None = None,
         plan_latency: int | None = None,
+        backup: Controller | None = None,
     ) -> None:
         super().__init__(robot, board)
         from ridempc.boards import load_board
@@ -385,8 +409,6 @@ class MpcRider(Controller):
         self._turn_time: float | None = None
         self._turn_rate = 0.0
         self._hold: MotorCommand | None = None
-        self._last_command: MotorCommand | None = None
-        self._wbc_misses = 0  # consecutive
         self._wbc_failures = 0  # in all
         self._hold_reason: str | None = None
         self._hold_time: float | None = None
@@ -395,6 +417,11 @@ class MpcRider(Controller):
         self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
         self._pending: _PendingSolve | None = None
         self._wbc_ms: list[float] = []
+        self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
+        self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
+        law = backup if backup is not None else _backup(robot, board)
+        shared = share_estimator(law, self.estimator)  # one filter for both
+        self.handover = Handover(law, standby_every=STANDBY_DIVIDER if shared else 1)
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
@@ -445,6 +472,8 @@ class MpcRider(Controller):
         self.map.anchor(self._mapped(estimate), (x, y, heading + turned))
 
     def _safe_hold(self, sensors: SensorPacket, reason: str) -> MotorCommand:
+        """The last resort, where even the backup law has no finite command: the joints
+        held where they are with the robot's default gains from then on."""
         if self._hold is None:
             n = len(self.robot.motors)
             self._hold = MotorCommand.hold(self.robot.motors, np.array(sensors.joint_position[:n]))
@@ -460,11 +489,26 @@ class MpcRider(Controller):
             self.reset(sensors)
         else:
             self.estimator.update(sensors)
+        primary, failure = self._primary(sensors, command)
+        self._tick += 1
+        out = self.handover.step(sensors, command, primary, failure, self._fit())
+        self._diagnostics["on_backup"] = float(self.handover.on_backup)
+        if not out.is_finite():
+            return self._safe_hold(sensors, f"no finite command from the backup law: {failure}")
+        return out
+
+    def _primary(
+        self, sensors: SensorPacket, command: Command
+    ) -> tuple[MotorCommand | None, str | None]:
+        """The MPC and whole-body QP's command this tick (None where they have none), and
+        why they cannot ride (None if they can): the estimate not finite, a plan or a QP
+        that failed, a QP that needed slack (:mod:`ridempc.wbc.elastic`), or the state
+        beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference."""
         estimate = self.estimator.state
         if estimate is None or not (
             np.isfinite(estimate.q).all() and np.isfinite(estimate.v).all()
         ):
-            return self._safe_hold(sensors, f"state estimate not finite at {sensors.time:.3f} s")
+            return None, "state estimate not finite"
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
         try:
@@ -472,20 +516,28 @@ class MpcRider(Controller):
                 self._mpc_tick(estimate, command, sensors.time)
             if self._pending is not None and self._tick >= self._pending.due:
                 self._adopt_pending()
+            if self._plan is None:
+                return None, "no MPC plan"
             out = self._wbc_tick(estimate, sensors.time)
         except WbcFailed as exc:
-            if self._last_command is None or self._wbc_misses >= WBC_GRACE_TICKS:
-                return self._safe_hold(sensors, f"WbcFailed at {sensors.time:.3f} s: {exc}")
-            self._wbc_misses += 1
             self._wbc_failures += 1
-            self._tick += 1
-            return self._last_command
+            return None, f"WbcFailed: {exc}"
         except RidempcError as exc:
-            return self._safe_hold(sensors, f"{type(exc).__name__} at {sensors.time:.3f} s: {exc}")
-        self._wbc_misses = 0
-        self._last_command = out
-        self._tick += 1
-        return out
+            return None, f"{type(exc).__name__}: {exc}"
+        if self._plan.fallback:
+            return out, f"MPC plan failed (status {self._plan.status})"
+        slack = self._diagnostics.get("wbc_slack", 0.0)
+        if slack > 0.0:
+            return out, f"whole-body QP infeasible (slack {slack:.3g})"
+        if self._deviation > HANDOVER_DEVIATION:
+            return out, f"state {self._deviation:.2g} of its tolerances from the reference"
+        return out, None
+
+    def _fit(self) -> bool:
+        """Whether the MPC may ride again: its plan solved (not the last one shifted) and
+        the state near its reference (:func:`~ridempc.mpc.handover.deviation`)."""
+        plan = self._plan
+        return plan is not None and not plan.fallback and self._deviation <= RETURN_DEVIATION
 
     def hold_speed(self) -> None:
         self.selector.holds_speed = True  # the library's ``repush`` entries, where it has them
@@ -578,6 +630,10 @@ class MpcRider(Controller):
             c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
         problem = self._held_forces(problem)
+        self._deviation = deviation(
+            problem.initial_state, problem.state_reference[0], problem.state_weights
+        )
+        self._diagnostics["mpc_deviation"] = self._deviation
         self._contacts = problem.contacts[0]
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
@@ -911,7 +967,9 @@ class MpcRider(Controller):
         if self.shoes is not None:
             self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
-        self._diagnostics.update(wbc_ms=self._wbc_ms[-1])
+        slack = self.wbc.last_solution.slack if self.wbc.last_solution is not None else 0.0
+        self._wbc_slack_max = max(self._wbc_slack_max, slack)
+        self._diagnostics.update(wbc_ms=self._wbc_ms[-1], wbc_slack=slack)
         return to_motor_command(out, self.kp, self.kd, torque=self.torque_lead(now, out.torque))
 
     # ------------------------------------------------------------------ reports
@@ -954,6 +1012,9 @@ class MpcRider(Controller):
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries
         out["wbc_daqp_solves"] = self.wbc.qp.fallbacks
+        out["wbc_elastic_solves"] = self.wbc.qp.elastic_solves
+        out["wbc_slack_max"] = self._wbc_slack_max
+        out["fallbacks"] = self.handover.summary()
         out["safe_hold"] = (
             None
             if self._hold_reason is None

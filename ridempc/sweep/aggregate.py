@@ -34,8 +34,10 @@ def sweep_results(
 
     Returns:
         ``controllers``: per controller ``rides``, ``survived``, ``failed``,
-        ``survival_rate``, ``survival_ci95`` (Wilson, [low, high]), ``metrics`` (median,
-        p90, min, max per metric) and ``worker_peak_rss_mib``; ``paired``: per pair of
+        ``fallback_rides`` and ``fallbacks`` (rides handed to a backup law, and handovers
+        in all: a summary's ``fallbacks``, :mod:`ridempc.mpc.handover`), ``survival_rate``,
+        ``survival_ci95`` (Wilson, [low, high]), ``metrics`` (median, p90, min, max per
+        metric) and ``worker_peak_rss_mib``; ``paired``: per pair of
         controllers the four paired counts and the exact McNemar p-value; ``failed``: the
         failed rides; ``variants``: per variant its drawn quantities and each controller's
         summary.
@@ -48,10 +50,13 @@ def sweep_results(
         kept = sum(outcomes[controller])
         low, high = wilson(kept, len(rides))
         memory = [s["worker_peak_rss_mib"] for s in rides if "worker_peak_rss_mib" in s]
+        handovers = [len(s.get("fallbacks") or ()) for s in rides]
         per_controller[controller] = {
             "rides": len(rides),
             "survived": kept,
             "failed": sum(1 for s in rides if s.get("status") == "failed"),
+            "fallback_rides": sum(1 for n in handovers if n),
+            "fallbacks": sum(handovers),
             "survival_rate": kept / len(rides) if rides else None,
             "survival_ci95": [low, high],
             "metrics": {

@@ -81,10 +81,14 @@ def _markdown_table(rows: Sequence[Sequence[str]]) -> str:
 
 def survival_table(results: Mapping[str, Any]) -> str:
     """Survival per controller and the paired counts, as Markdown (also printed)."""
-    rows = [["controller", "survived", "rate", "95 % interval", "failed", "worker memory"]]
+    rows = [
+        ["controller", "survived", "rate", "95 % interval", "failed", "fallbacks", "worker memory"]
+    ]
     for name, c in results["controllers"].items():
         low, high = c["survival_ci95"]
         memory = c["worker_peak_rss_mib"]
+        # rides handed to a backup law (ridempc.mpc.handover), and handovers in all
+        handed = f"{c.get('fallback_rides', 0)} rides ({c.get('fallbacks', 0)})"
         rows.append(
             [
                 name,
@@ -92,6 +96,7 @@ def survival_table(results: Mapping[str, Any]) -> str:
                 f"{c['survival_rate']:.1%}",
                 f"[{low:.1%}, {high:.1%}]",
                 str(c["failed"]),
+                handed,
                 "-" if memory is None else f"{memory:.0f} MiB",
             ]
         )

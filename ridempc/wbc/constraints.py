@@ -66,9 +66,12 @@ class Constraint(ABC):
 
     Attributes:
         rows: Number of rows, the same at every tick.
+        soft: Whether its rows may give way, with a slack, when the QP has no solution
+            (:mod:`ridempc.wbc.elastic`); the dynamics and the torque limits never do.
     """
 
     rows: int
+    soft: bool = False
 
     def __init__(self, layout: DecisionLayout) -> None:
         self.layout = layout
@@ -158,6 +161,8 @@ class RigidSpringConstraint(Constraint):
         damping: :math:`k_d` [1/s].
     """
 
+    soft = True  # a model of a stiff spring, not physics: it may give way
+
     def __init__(self, layout: DecisionLayout, spring_v: Index, damping: float) -> None:
         super().__init__(layout)
         self.rows = len(spring_v)
@@ -180,6 +185,9 @@ class ClosedChainConstraint(Constraint):
     Args:
         layout: The decision vector's layout.
     """
+
+    # its drift comes from estimated velocities, which a fall can make contradict the dynamics
+    soft = True
 
     def __init__(self, layout: DecisionLayout) -> None:
         super().__init__(layout)
@@ -211,6 +219,8 @@ class ContactAccelerationConstraint(Constraint):
         site_partner: Per site, the first site of its line foot if it is the second, else -1.
         line_basis: Per site, :math:`B_s` (used for the second sites), shape (sites, 2, 3).
     """
+
+    soft = True  # a planned contact may be slipping or lifting already
 
     def __init__(self, layout: DecisionLayout, site_partner: Index, line_basis: Array) -> None:
         super().__init__(layout)
@@ -281,6 +291,8 @@ class FrictionPyramidConstraint(Constraint):
         max_normal_force: :math:`f_{max}` [N].
         shape: The pyramid's shape (:func:`ridempc.friction.pyramid_rows`).
     """
+
+    soft = True  # a planned contact may not be able to give the force
 
     def __init__(
         self,
@@ -359,6 +371,8 @@ class PlatformTipConstraint(Constraint):
         platforms: How many platforms tip (rows for each; a platform without sites in a
             tick keeps its rows empty).
     """
+
+    soft = True  # the tread's edge models the platform; not a limit of the robot
 
     def __init__(self, layout: DecisionLayout, platforms: int) -> None:
         super().__init__(layout)

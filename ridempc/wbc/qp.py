@@ -35,6 +35,11 @@ warm and cold, and DAQP solved it to 1e-12 in 0.2 ms.
 measured fastest on the recorded problems: DAQP, to which every problem then goes straight
 (:func:`ridempc.solvers.solve_dense`); ``solver="osqp"`` takes the workspace above, so that
 ``ridempc bench --wbc-solver osqp`` measures the choice in the closed loop.
+
+**Always a command.** Where every solver finds the problem infeasible, its soft rows are
+given a slack (:mod:`ridempc.wbc.elastic`), the dynamics and the torque limits kept, and
+that problem, which always has a solution, goes to DAQP; the slack is recorded in the
+solution (:attr:`QpSolution.slack`) and the solves counted (:attr:`WholeBodyQP.elastic_solves`).
 """
 
 from __future__ import annotations
@@ -51,6 +56,7 @@ from ridempc.errors import RidempcError
 from ridempc.solvers import solve_daqp, solve_dense, solver_for
 from ridempc.wbc.constraints import Constraint, LinearConstraint
 from ridempc.wbc.contacts import ContactSet
+from ridempc.wbc.elastic import elastic_problem, solve_elastic
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
 from ridempc.wbc.settings import DEFAULT_OSQP_SETTINGS
@@ -102,6 +108,8 @@ class QpSolution:
             solution onto its active set.
         solve_time: Update of the workspace, factorisation and solve, wall clock [s].
         osqp_time: OSQP's own run time (factorisation, iterations, polish) [s].
+        slack: The largest slack the soft rows took (0 where the problem was solved as
+            it is), in its row's units [m/s^2 or N].
     """
 
     x: Array
@@ -112,6 +120,7 @@ class QpSolution:
     refined: bool
     solve_time: float
     osqp_time: float
+    slack: float = 0.0
 
 
 def _violation(problem: QpProblem, ax: Array) -> float:
@@ -188,6 +197,7 @@ class WholeBodyQP:
             the pattern had to widen, or after a failed solve, which restarts cold).
         cold_retries: Warm-started solves that failed and were retried cold.
         fallbacks: Solves OSQP failed and DAQP answered.
+        elastic_solves: Solves that needed slack on the soft rows (module docstring).
         last: The last solution, or None.
     """
 
@@ -205,6 +215,10 @@ class WholeBodyQP:
         self.constraints = tuple(c for c in constraints if c.rows > 0)
         self.settings = {**DEFAULT_OSQP_SETTINGS, **(settings or {})}
         self.rows = sum(c.rows for c in self.constraints)
+        # per row: whether it may take a slack (ridempc.wbc.elastic)
+        self.soft = np.repeat(
+            [c.soft for c in self.constraints], [c.rows for c in self.constraints]
+        )
         ends = np.cumsum([0] + [c.rows for c in self.constraints])
         self._row_slices = tuple(slice(a, b) for a, b in zip(ends[:-1], ends[1:], strict=True))
         n = layout.size
@@ -216,6 +230,7 @@ class WholeBodyQP:
         self.setups = 0
         self.cold_retries = 0
         self.fallbacks = 0
+        self.elastic_solves = 0
         self.last: QpSolution | None = None
 
     # ----------------------------------------------------------------- build
@@ -248,14 +263,53 @@ class WholeBodyQP:
     # ----------------------------------------------------------------- solve
 
     def solve(self, problem: QpProblem) -> QpSolution:
-        """Solve ``problem`` in the persistent workspace.
+        """Solve ``problem`` as it is, or where it has no solution, with slack on its soft
+        rows (module docstring).
+
+        Raises:
+            WbcFailed: Neither finds a finite solution (the elastic problem always has
+                one: a backend's numerical failure).
+        """
+        start = time.perf_counter()
+        try:
+            return self._solve_hard(problem, start)
+        except WbcFailed as failed:
+            return self._solve_elastic(problem, failed, start)
+
+    def _solve_elastic(self, problem: QpProblem, failed: WbcFailed, start: float) -> QpSolution:
+        """``problem`` with slack on its soft rows, by DAQP.
+
+        Raises:
+            WbcFailed: ``failed``, where DAQP finds no solution to it either.
+        """
+        elastic = elastic_problem(problem.P, problem.q, problem.A, problem.l, problem.u, self.soft)
+        x, slack, answer = solve_elastic(elastic)
+        if not answer.found:
+            raise failed
+        self.elastic_solves += 1
+        duals = answer.duals if answer.duals is not None else np.zeros(len(problem.l))
+        solution = QpSolution(
+            x=x,
+            y=duals,
+            status="solved with slack",
+            iterations=answer.iterations,
+            polished=True,
+            refined=False,
+            solve_time=time.perf_counter() - start,
+            osqp_time=0.0,
+            slack=float(np.max(np.abs(slack), initial=0.0)),
+        )
+        self.last = solution
+        return solution
+
+    def _solve_hard(self, problem: QpProblem, start: float) -> QpSolution:
+        """Solve ``problem`` in the persistent workspace, or by the dense backend.
 
         Raises:
             WbcFailed: OSQP's status is not ``solved`` or ``solved inaccurate``, or the
                 solution is not finite (after a retry from a cold start, if it was warm),
                 and DAQP finds no solution either.
         """
-        start = time.perf_counter()
         if self.solver != "osqp":
             return self._dense(problem, start)
         solver = self._solver

@@ -1,0 +1,303 @@
+"""Handing the ride to a backup balance law and back, with the motor commands blended.
+
+A tracking controller (the MPC rider) rides while its plans and whole-body QPs solve and
+its state stays near its reference. When one of them fails, the ride is handed to a
+*backup* law that balances the same robot on the same board from the same sensors (the
+pair's PD baseline, :data:`ridempc.controllers.registry.CONTROLLERS`), and handed back
+once the tracking controller has been *fit* again for :data:`RETURN_DWELL_S` (doubled at
+each further handover, :meth:`Handover.dwell`):
+
+.. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
+          \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
+
+over every field of the motor command (feedforward torque, targets and gains). The backup
+runs beside the primary (hot standby): its estimator, filters and integrators are current
+at the moment it takes over, and its nominal posture is the one it took at the ride's
+start, as when it rides alone.
+
+The standby would cost the backup's whole tick at every tick. Most of that is its state
+estimator, the same filter on the same sensors as the primary's where both see the same
+platforms: there it reads the primary's estimate instead (:func:`share_estimator`), and
+runs in standby only every :data:`STANDBY_DIVIDER` ticks.
+
+Nothing here names a robot, a board or a law: :class:`Handover` takes the backup as a
+:class:`~ridempc.controllers.base.Controller` and is told, each tick, the primary's
+command (or None), why it failed (or None) and whether it is fit to ride.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ridempc.controllers.base import Controller
+from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.scenarios.scenario import Command
+from ridempc.sim.motors import MotorCommand
+from ridempc.sim.sensors import SensorPacket
+
+__all__ = [
+    "BLEND_S",
+    "HANDOVER_DEVIATION",
+    "RETURN_DEVIATION",
+    "RETURN_DWELL_S",
+    "STANDBY_DIVIDER",
+    "Fallback",
+    "Handover",
+    "SharedEstimate",
+    "blend",
+    "deviation",
+    "share_estimator",
+]
+
+# [s] the blend of the two laws' commands: 10 ticks at 500 Hz, so no field of the command
+# steps by more than a tenth of the two laws' difference in a tick, and a failed law's
+# command is out within 20 ms (0.1 and 0.3 s changed nothing on the ride tried, Segway
+# stand-still seed 6).
+BLEND_S: float = 0.02
+# [s] how long the primary must be fit before it rides again, the hysteresis in time: 15
+# MPC solves in a row near the reference, so that one good solve in a fall, or a rider at
+# the edge of the primary's region, does not hand the ride back and forth.
+RETURN_DWELL_S: float = 0.5
+# [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
+# beyond which its linear model no longer holds and the ride is handed over: 1.7 times the
+# largest the MPC reached in the library's manoeuvres (1.40-1.75: Segway push and
+# velocity-steps, Hovershoes velocity-steps, skateboard push-off-0.5, seed 0).
+HANDOVER_DEVIATION: float = 3.0
+# [-] the same error below which the primary may ride again: a third of the handover's,
+# the band between them the hysteresis (standing still on the Hovershoes it sits at
+# 0.55-0.67 once settled).
+RETURN_DEVIATION: float = 1.0
+# [ticks] the backup's standby rate while the primary rides, where it reads the primary's
+# estimate (SharedEstimate): every 15th tick (33 Hz at 500 Hz). Its filters, integrators and
+# rate limits step by the sample times, so they stay current; the first tick (where it takes
+# its nominal posture) and every tick from a handover on run it in full.
+STANDBY_DIVIDER: int = 15
+# [s] times within this are equal: a tick's time carries the rounding of its sum
+TIME_TOLERANCE: float = 1e-9
+
+
+@dataclass
+class Fallback:
+    """One handover to the backup.
+
+    Attributes:
+        time_s: When it began [s].
+        reason: Why the primary could not ride.
+        duration_s: How long the backup rode [s]; None while it still rides.
+    """
+
+    time_s: float
+    reason: str
+    duration_s: float | None = None
+
+    def record(self) -> dict[str, Any]:
+        """For ``summary.json``."""
+        return {"time_s": self.time_s, "reason": self.reason, "duration_s": self.duration_s}
+
+
+def blend(start: MotorCommand, end: MotorCommand, alpha: float) -> MotorCommand:
+    """:math:`(1 - \\alpha)\\, start + \\alpha\\, end`, field by field."""
+    if alpha >= 1.0:
+        return end
+    a, b = 1.0 - alpha, alpha
+    return MotorCommand(
+        torque=a * start.torque + b * end.torque,
+        position=a * start.position + b * end.position,
+        velocity=a * start.velocity + b * end.velocity,
+        kp=a * start.kp + b * end.kp,
+        kd=a * start.kd + b * end.kd,
+    )
+
+
+class Handover:
+    """Which law rides, and the blend between them.
+
+    Args:
+        backup: The backup law.
+        blend_s: :math:`T_{blend}` [s].
+        dwell_s: How long the primary must be fit before it rides again [s].
+        standby_every: While the primary rides, the backup runs at every this many ticks
+            (1: every tick, as it must with an estimator of its own); half a period after
+            the first, off the ticks a primary with a slower loop of its own starts from.
+
+    Attributes:
+        fallbacks: Every handover so far, in order.
+    """
+
+    def __init__(
+        self,
+        backup: Controller,
+        blend_s: float = BLEND_S,
+        dwell_s: float = RETURN_DWELL_S,
+        standby_every: int = 1,
+    ) -> None:
+        self.backup = backup
+        self.standby_every = standby_every
+        self._ticks = 0
+        self._backup_command: MotorCommand | None = None
+        self.blend_s = blend_s
+        self.dwell_s = dwell_s
+        self.fallbacks: list[Fallback] = []
+        self._switch_time: float | None = None  # [s] the last switch, either way
+        self._from: MotorCommand | None = None  # the command blended out of since then
+        self._fit_since: float | None = None
+        self._last_primary: MotorCommand | None = None
+
+    def dwell(self) -> float:
+        """How long the primary must be fit before it rides again [s]: :attr:`dwell_s`,
+        doubled at each handover after the first, so that a primary that keeps failing
+        (a model error it cannot absorb) rides less and less."""
+        return self.dwell_s * 2.0 ** max(len(self.fallbacks) - 1, 0)
+
+    @property
+    def on_backup(self) -> bool:
+        """Whether the backup rides."""
+        return bool(self.fallbacks) and self.fallbacks[-1].duration_s is None
+
+    def step(
+        self,
+        sensors: SensorPacket,
+        command: Command,
+        primary: MotorCommand | None,
+        failure: str | None,
+        fit: bool,
+    ) -> MotorCommand:
+        """One tick: the backup updated, the handover decided, the command to send.
+
+        Args:
+            sensors: This tick's packet (for the backup).
+            command: The ride's command (for the backup).
+            primary: The primary's command this tick, None where it has none.
+            failure: Why the primary cannot ride this tick, None if it can.
+            fit: Whether the primary is fit to ride again (plans and QPs solving, the state
+                near its reference); read only while the backup rides.
+        """
+        now = sensors.time
+        backup = self._backup(sensors, command, primary is None or failure is not None)
+        if not self.on_backup:
+            if failure is None and primary is not None:
+                self._last_primary = primary
+                return self._blended(now, primary)
+            start = primary if primary is not None else self._last_primary
+            self.fallbacks.append(Fallback(now, failure or "no command"))
+            self._switch(now, start if start is not None else backup)
+            self._fit_since = None
+            return self._blended(now, backup)
+        if failure is None and primary is not None and fit:
+            self._fit_since = now if self._fit_since is None else self._fit_since
+            if now - self._fit_since >= self.dwell() - TIME_TOLERANCE:
+                current = self.fallbacks[-1]
+                current.duration_s = now - current.time_s
+                self._switch(now, self._blended(now, backup))
+                self._last_primary = primary
+                return self._blended(now, primary)
+        else:
+            self._fit_since = None
+        return self._blended(now, backup)
+
+    def _backup(self, sensors: SensorPacket, command: Command, needed: bool) -> MotorCommand:
+        """The backup's command: run this tick where it rides, is blended or ``needed``, on
+        its first tick, and every :attr:`standby_every` ticks in standby."""
+        tick, self._ticks = self._ticks, self._ticks + 1
+        every = self.standby_every
+        standby = tick % every == every // 2 if every > 1 else True
+        if (
+            self._backup_command is None
+            or needed
+            or standby
+            or self.on_backup
+            or self._switch_time is not None
+        ):
+            self._backup_command = self.backup.update(sensors, command)
+        return self._backup_command
+
+    def _switch(self, now: float, start: MotorCommand) -> None:
+        self._switch_time, self._from = now, start
+
+    def _blended(self, now: float, target: MotorCommand) -> MotorCommand:
+        """``target``, blended in from the last switch's command over :attr:`blend_s`."""
+        if self._switch_time is None or self._from is None:
+            return target
+        elapsed = now - self._switch_time + TIME_TOLERANCE
+        alpha = elapsed / self.blend_s if self.blend_s > 0.0 else 1.0
+        if alpha >= 1.0:
+            self._switch_time = self._from = None
+            return target
+        return blend(self._from, target, max(alpha, 0.0))
+
+    def summary(self) -> list[dict[str, Any]]:
+        """Every handover, for ``summary.json``'s ``fallbacks``."""
+        return [f.record() for f in self.fallbacks]
+
+
+def deviation(
+    state: NDArray[np.float64], reference: NDArray[np.float64], weights: NDArray[np.float64]
+) -> float:
+    """How far ``state`` is from ``reference``, in units of what the weights accept: with
+    each state's weight the inverse square of its acceptable error,
+    :math:`Q_i = 1/\\sigma_i^2` (Bryson's rule, as the MPC's weights are set),
+
+    .. math:: d = \\sqrt{\\tfrac1n \\textstyle\\sum_i Q_i (x_i - x^{ref}_i)^2}
+
+    [-], the root mean square over the :math:`n` states: :math:`d \\le 1` is the states
+    within their acceptable errors on the whole.
+    """
+    squared = np.maximum(weights, 0.0) * (state - reference) ** 2
+    return float(np.sqrt(np.mean(squared))) if squared.size else 0.0
+
+
+class SharedEstimate:
+    """A backup's stand-in for its state estimator: the primary's estimator, updated by the
+    primary each tick before the backup runs, which ``reset`` and ``update`` only read;
+    where the primary's estimate is not finite (a diverged filter, a sensor fault), the
+    backup's own estimator restarts from that packet and runs on alone from then on.
+
+    Args:
+        estimator: The primary's estimator.
+        own: The backup's own estimator (the same filter), idle while shared.
+    """
+
+    def __init__(self, estimator: StateEstimator, own: StateEstimator) -> None:
+        self._estimator = estimator
+        self._own = own
+        self.detached = False
+
+    @property
+    def state(self) -> EstimatedState | None:
+        return (self._own if self.detached else self._estimator).state
+
+    def reset(self, packet: SensorPacket, *args: Any, **kwargs: Any) -> EstimatedState | None:
+        return self.update(packet)
+
+    def update(self, packet: SensorPacket) -> EstimatedState | None:
+        if self.detached:
+            return self._own.update(packet)
+        state = self._estimator.state
+        if state is not None and np.isfinite(state.q).all() and np.isfinite(state.v).all():
+            return state
+        self.detached = True
+        return self._own.reset(packet)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._own if self.detached else self._estimator, name)
+
+
+def share_estimator(backup: Controller, estimator: StateEstimator) -> bool:
+    """Give ``backup`` the primary's ``estimator`` in place of its own
+    (:class:`SharedEstimate`), where its own is the same filter (the same robot,
+    platforms and support height); returns whether it did."""
+    own = getattr(backup, "estimator", None)
+    if not isinstance(own, StateEstimator):
+        return False
+    same = (
+        own.robot is estimator.robot
+        and own.platforms == estimator.platforms
+        and own.support_height == estimator.support_height
+    )
+    if same:
+        backup.estimator = SharedEstimate(estimator, own)  # type: ignore[attr-defined]
+    return same

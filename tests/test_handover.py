@@ -1,0 +1,132 @@
+"""The handover between the MPC and a backup law (``ridempc.mpc.handover``), without a ride:
+a stand-in backup and made-up commands, ticked at 500 Hz."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ridempc.mpc.handover import BLEND_S, Handover, blend, deviation
+from ridempc.sim.motors import MotorCommand
+
+DT = 0.002  # [s] the rider's tick
+
+
+def _command(value: float) -> MotorCommand:
+    return MotorCommand(*(np.full(3, value) for _ in range(5)))
+
+
+class _Backup:
+    """A backup law that sends 1 everywhere and counts its ticks."""
+
+    def __init__(self) -> None:
+        self.ticks = 0
+
+    def update(self, sensors: Any, command: Any) -> MotorCommand:
+        self.ticks += 1
+        return _command(1.0)
+
+
+def _run(handover: Handover, ticks: int, start: int, fails: range, fit: bool = True) -> list:
+    sent = []
+    for k in range(start, start + ticks):
+        sensors = SimpleNamespace(time=k * DT)
+        failure = "WbcFailed: test" if k in fails else None
+        sent.append(handover.step(sensors, None, _command(0.0), failure, fit))  # type: ignore[arg-type]
+    return sent
+
+
+def test_hands_over_at_the_first_failure_blended_and_back_after_the_dwell() -> None:
+    backup = _Backup()
+    handover = Handover(backup, dwell_s=0.1)  # type: ignore[arg-type]
+    sent = _run(handover, 300, 0, range(50, 60))
+    assert backup.ticks == 300  # hot standby: every tick
+    torque = np.array([c.torque[0] for c in sent])
+    assert np.all(torque[:50] == 0.0)  # the primary rides
+    ramp = round(BLEND_S / DT)
+    np.testing.assert_allclose(torque[50 : 50 + ramp], np.arange(ramp) / ramp, atol=1e-6)
+    back = 60 + round(0.1 / DT)  # the first fit tick, then the dwell
+    assert np.all(torque[50 + ramp : back] == 1.0)  # the backup rides
+    np.testing.assert_allclose(torque[back : back + ramp], 1.0 - np.arange(ramp) / ramp, atol=1e-6)
+    assert np.all(torque[back + ramp :] == 0.0)
+    (record,) = handover.summary()
+    assert record == {
+        "time_s": pytest.approx(0.1),
+        "reason": "WbcFailed: test",
+        "duration_s": pytest.approx((back - 50) * DT),
+    }
+
+
+def test_stays_on_the_backup_while_the_primary_is_unfit() -> None:
+    handover = Handover(_Backup(), dwell_s=0.1)  # type: ignore[arg-type]
+    _run(handover, 200, 0, range(10, 11), fit=False)
+    assert handover.on_backup and handover.summary()[0]["duration_s"] is None
+
+
+def test_a_failure_in_the_dwell_starts_it_again() -> None:
+    handover = Handover(_Backup(), dwell_s=0.1)  # type: ignore[arg-type]
+    fails = set(range(10, 11)) | {50}  # fit from tick 11, failed again at 50
+    sent = _run(handover, 200, 0, fails)  # type: ignore[arg-type]
+    back = 51 + round(0.1 / DT)
+    assert sent[back - 1].torque[0] == 1.0 and sent[back + 1].torque[0] < 1.0  # blended back
+    assert handover.summary()[0]["duration_s"] == pytest.approx((back - 10) * DT)
+
+
+def test_blend_and_deviation() -> None:
+    mixed = blend(_command(0.0), _command(2.0), 0.25)
+    assert mixed.kp[0] == pytest.approx(0.5) and mixed.torque[0] == pytest.approx(0.5)
+    weights = np.array([400.0, 100.0, 0.0])  # sigmas 0.05, 0.1 and a free state
+    assert deviation(np.array([0.05, 0.0, 9.0]), np.zeros(3), weights) == pytest.approx(
+        np.sqrt(1 / 3)
+    )
+
+
+def test_the_dwell_doubles_at_each_further_handover() -> None:
+    handover = Handover(_Backup(), dwell_s=0.1)  # type: ignore[arg-type]
+    _run(handover, 100, 0, range(10, 11))  # back at tick 61
+    assert handover.dwell() == pytest.approx(0.1) and not handover.on_backup
+    _run(handover, 200, 100, range(110, 111))
+    assert len(handover.summary()) == 2 and handover.dwell() == pytest.approx(0.2)
+    assert handover.summary()[1]["duration_s"] == pytest.approx(0.202)  # one tick, the dwell
+
+
+def test_in_standby_the_backup_runs_on_its_first_tick_then_every_nth() -> None:
+    backup = _Backup()
+    handover = Handover(backup, standby_every=15)  # type: ignore[arg-type]
+    _run(handover, 45, 0, range(0))
+    assert backup.ticks == 1 + 3  # tick 0, then 7, 22 and 37
+    _run(handover, 20, 45, range(50, 51))  # from the failure on, every tick
+    assert backup.ticks == 4 + 15  # none in standby at 45-49, then every tick of 50-64
+
+
+class _Estimator:
+    """A stand-in estimator: its state, and how often it was reset and updated."""
+
+    def __init__(self, q: float) -> None:
+        self.state = SimpleNamespace(q=np.array([q]), v=np.zeros(1))
+        self.resets = self.updates = 0
+
+    def reset(self, packet: Any) -> Any:
+        self.resets += 1
+        return self.state
+
+    def update(self, packet: Any) -> Any:
+        self.updates += 1
+        return self.state
+
+
+def test_a_shared_estimate_is_read_and_left_for_the_own_filter_when_not_finite() -> None:
+    from ridempc.mpc.handover import SharedEstimate
+
+    primary, own = _Estimator(1.0), _Estimator(2.0)
+    shared = SharedEstimate(primary, own)  # type: ignore[arg-type]
+    assert shared.reset(None).q[0] == 1.0 and shared.update(None).q[0] == 1.0  # type: ignore[arg-type, union-attr]
+    assert primary.updates == primary.resets == own.updates == own.resets == 0
+    primary.state.q[0] = np.nan
+    assert shared.update(None).q[0] == 2.0 and own.resets == 1  # type: ignore[arg-type, union-attr]
+    primary.state.q[0] = 1.0  # once left, the own filter runs on
+    assert shared.update(None).q[0] == 2.0 and own.updates == 1  # type: ignore[arg-type, union-attr]
+    assert shared.detached and shared.state.q[0] == 2.0  # type: ignore[union-attr]
