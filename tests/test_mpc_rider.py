@@ -52,8 +52,8 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     taken: list[tuple[int, float, float]] = []  # tick, time of its state, plan's time
     adopt = rider._adopt
 
-    def adopting(solve, outcome):
-        adopt(solve, outcome)
+    def adopting(solve, built):
+        adopt(solve, built)
         taken.append((rider._tick, solve.time, rider._plan_time))
 
     rider._adopt = adopting
@@ -64,6 +64,11 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     assert len(rider.mpc_tick_ms) == len(taken) and rider.mpc_loop_seconds > 0.0
     again, _ = _ride(dog, 0.2, MpcRider(dog, "skateboard", plan_latency=1))
     np.testing.assert_array_equal(again.log["qpos"], first.log["qpos"])
+    in_tick = MpcRider(dog, "skateboard", plan_latency=1)
+    in_tick.off_tick = False  # built and solved in the tick, taken up a tick later
+    inline, _ = _ride(dog, 0.2, in_tick)
+    np.testing.assert_array_equal(inline.log["qpos"], first.log["qpos"])
+    assert in_tick.summary()["mpc_solves"] == rider.summary()["mpc_solves"]
     at_once, _ = _ride(dog, 0.2)
     assert at_once.status == "ok"
     assert np.abs(at_once.log["qpos"][-1] - first.log["qpos"][-1]).max() > 0.0  # it is used
@@ -222,9 +227,9 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
     steps: list[tuple] = []  # t, wx0, planned wx1, board speed, its reference, support
     adopt = rider._adopt
 
-    def planning(solve, outcome):  # each plan as it takes over, with its problem
-        adopt(solve, outcome)
-        problem, plan = solve.started.problem, rider._plan
+    def planning(solve, built):  # each plan as it takes over, with its problem
+        adopt(solve, built)
+        problem, plan = built.started.problem, rider._plan
         x0, reference = problem.initial_state, problem.state_reference[0]
         steps.append(
             (

@@ -9,8 +9,9 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes OSQP iterates in a thread
-   of its own, as the robots run their MPC beside their WBC, and the plan takes over one
+   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes the problem is built and
+   OSQP iterates in a thread of its own, as the robots run their MPC beside their WBC, from
+   what the tick sends it (:meth:`MpcRider._build_and_run`), and the plan takes over one
    tick, 2 ms, after the state it starts from, waited for then whatever the machine, the
    tick between following the previous plan in its own library frame: the pair's
    ``plan_latency``) on the manoeuvre the command asks for
@@ -72,11 +73,12 @@ from then on, and its ``summary()`` says why and when.
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from concurrent.futures import Future
 from dataclasses import replace
-from functools import cache
+from functools import cache, partial
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -150,18 +152,46 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 WBC_GRACE_TICKS: int = 5
 
 
-class _PendingSolve(NamedTuple):
-    """An MPC solve under way: the started QP, the library frame its problem is in, the
-    time of the state it starts from [s], the tick its plan takes over, the time spent
-    building the problem [s], and the solver thread's future (None when solved in the
-    tick)."""
+class _BuildInputs(NamedTuple):
+    """What an MPC problem is built from, as the loop has it at the MPC's tick: the
+    reference's time [s], the mapped state, the rates' drift (or None), the tick's time
+    [s], the board's speed [m/s], the commanded roll at the horizon's nodes [rad], the
+    turn over its steps [rad/s], the turn so far [rad], whether the rider coasts, whether
+    the manoeuvre switched at this tick, the lean loop (a copy, or None) and the shoes'
+    observer (frozen, or None)."""
+
+    t_ref: float
+    x0: Array
+    drift: Array | None
+    now: float
+    speed: float
+    roll: Array
+    turn: Array
+    turned: float
+    coasting: bool
+    switched: bool
+    lean: LeanSteering | None
+    shoes: ShoeObserver | None
+
+
+class _Built(NamedTuple):
+    """An MPC problem built, started and run (:meth:`MpcRider._build_and_run`): the
+    started QP, OSQP's outcome and the time spent building the problem [s]."""
 
     started: StartedSolve
+    outcome: SolveOutcome
+    build_s: float
+
+
+class _PendingSolve(NamedTuple):
+    """An MPC solve under way: the library frame its problem is in, the time of the state
+    it starts from [s], the tick its plan takes over, and its built and solved problem to
+    come (None when built and solved in the tick)."""
+
     frame: PlanarFrame
     time: float
     due: int
-    build_s: float
-    future: Future[SolveOutcome] | None = None
+    future: Future[_Built] | None = None
 
 
 @cache
@@ -224,6 +254,10 @@ class MpcRider(Controller):
     """
 
     rate_hz = 500.0
+    # Whether a solve with a ``plan_latency`` builds its problem and solves it in the solver
+    # thread beside the loop (else in its tick, its plan still taken up ``plan_latency``
+    # ticks later: the same ride, bit for bit).
+    off_tick: bool = True
 
     def __init__(
         self,
@@ -537,55 +571,84 @@ class MpcRider(Controller):
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
-        problem = self.mpc.problem(t_ref, x0, drift)
+            self._diagnostics["lean_offset"] = self.lean.offset
+        inputs = _BuildInputs(  # what the loop's state says now, copied: the build may run
+            t_ref,  # beside the loop's next ticks, which move the shoes' observer on
+            x0,
+            drift,
+            now,
+            speed,
+            roll,
+            turn,
+            self._turned,
+            coasting,
+            switched,
+            copy.copy(self.lean),
+            self.shoes.frozen() if self.shoes is not None else None,
+        )
+        pending = _PendingSolve(  # the frame the plan is in: the map's moves on at the next
+            self.map.frame, now, self._tick + self.plan_latency  # tick, the plan only when
+        )  # this one takes over
+        if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
+            self._adopt(pending, self._build_and_run(inputs))
+        elif not self.off_tick:
+            future: Future[_Built] = Future()
+            future.set_result(self._build_and_run(inputs))
+            self._pending = pending._replace(future=future)
+        else:
+            self._pending = pending._replace(
+                future=_solver_thread().submit(partial(self._build_and_run, inputs))
+            )
+        self._mpc_main_s += time.perf_counter() - started
+
+    def _build_and_run(self, inputs: _BuildInputs) -> _Built:
+        """The MPC problem of one tick built from ``inputs`` (and the build's own state:
+        the QP's warm start, a re-push's blend, the crouch's start, the static shifts
+        kept by key), started and solved; in the control loop's thread or in the solver
+        thread beside it (``off_tick``), the same either way."""
+        started = time.perf_counter()
+        problem = self._shaped(self.mpc.problem(inputs.t_ref, inputs.x0, inputs.drift), inputs)
+        if self.mpc.qp is None:
+            self.mpc.qp = self.mpc.build_qp(problem)
+        build = time.perf_counter() - started
+        begun = self.mpc.qp.start(problem)
+        return _Built(begun, self.mpc.qp.run(), build)
+
+    def _shaped(self, problem: MpcProblem, inputs: _BuildInputs) -> MpcProblem:
+        """``problem`` shaped by the rider's steps: coasting, the commanded roll, a
+        re-push's blend, the turn, the crouch, the lean, the shoes' lines and drags and
+        the swing's held forces."""
+        names, t_ref, speed = self.layout.names, inputs.t_ref, inputs.speed
         # A re-push before its first push (while its blend runs) coasts too, its speeds
         # scaled to the board's: the entry's planned body speed, faster than a deck that
         # slows more than its model, had the MPC push the body forward and brake the deck.
-        if coasting or self._blend is not None:
+        if inputs.coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
-        if self.selector.commands_roll(names, roll):
+        if self.selector.commands_roll(names, inputs.roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
-        problem = self.selector.with_command(problem, names, roll, balance)
-        if switched:
+        problem = self.selector.with_command(problem, names, inputs.roll, balance)
+        if inputs.switched:
             self._blend = SwitchBlend.at_switch(problem, self.mpc.reference, self.layout, t_ref)
         if self._blend is not None:
             problem = self._blend(problem, t_ref)
             self._blend = None if self._blend.done(t_ref) else self._blend
-        problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
+        problem = self.selector.with_turn(problem, self.layout, inputs.turn, inputs.turned)
         if self.crouch is not None:
-            problem = self.crouch.lower(problem, names["com_z"], now)
-        if self.lean is not None:
-            if self.lean.offset != 0.0:
+            problem = self.crouch.lower(problem, names["com_z"], inputs.now)
+        lean = inputs.lean
+        if lean is not None:
+            if lean.offset != 0.0:
                 balance = self._lean_balance(t_ref)
-                problem = self.lean.lean(problem, names["com_y"], names["vy"], balance)
-            problem = self.lean.turn(problem, names)
-            self._diagnostics["lean_offset"] = self.lean.offset
-        if self.shoes is not None:  # each shoe's heading turned towards its line, its
+                problem = lean.lean(problem, names["com_y"], names["vy"], balance)
+            problem = lean.turn(problem, names)
+        if inputs.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
             states = steer_onto_lines(problem.state_reference, problem.initial_state, columns)
-            states = self.shoes.shift_reference(states, columns)
-            c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
+            states = inputs.shoes.shift_reference(states, columns)
+            c = inputs.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
-        problem = self._held_forces(problem)
-        self._contacts = problem.contacts[0]
-        if self.mpc.qp is None:
-            self.mpc.qp = self.mpc.build_qp(problem)
-        self._last_problem = problem
-        build = time.perf_counter() - started
-        solve = _PendingSolve(  # the frame the plan is in: the map's moves on at the next
-            self.mpc.qp.start(problem),  # tick, the plan only when this one takes over
-            self.map.frame,
-            now,
-            self._tick + self.plan_latency,
-            build,
-        )
-        if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
-            self._adopt(solve, self.mpc.qp.run())
-        else:
-            future = _solver_thread().submit(self.mpc.qp.run)
-            self._pending = solve._replace(future=future)
-        self._mpc_main_s += time.perf_counter() - started
+        return self._held_forces(problem)
 
     def _adopt_pending(self) -> None:
         """The pending solve's plan taken up, once its tick has come (waiting for it if
@@ -596,19 +659,21 @@ class MpcRider(Controller):
         self._adopt(solve, solve.future.result())
         self._mpc_main_s += time.perf_counter() - started
 
-    def _adopt(self, solve: _PendingSolve, outcome: SolveOutcome) -> None:
-        """The plan of ``solve`` (OSQP's ``outcome``) in force from this tick on, timed
-        from the state it was solved from."""
+    def _adopt(self, solve: _PendingSolve, built: _Built) -> None:
+        """The plan of ``solve`` (its problem ``built`` and solved) in force from this tick
+        on, timed from the state it was solved from."""
         assert self.mpc.qp is not None
-        plan = self.mpc.qp.finish(solve.started, outcome)
-        self._mpc_ms.append(1e3 * (solve.build_s + plan.solve_time))
+        problem = built.started.problem
+        self._contacts, self._last_problem = problem.contacts[0], problem
+        plan = self.mpc.qp.finish(built.started, built.outcome)
+        self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
         if self.force_filter is not None:
             plan = plan._replace(first_input=self.force_filter(plan.first_input, solve.time))
         self._plan, self._plan_time, self._plan_frame = plan, solve.time, solve.frame
-        self._set_support(solve.started.problem.contacts[0])
+        self._set_support(problem.contacts[0])
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
             mpc_fallback=float(plan.fallback),
