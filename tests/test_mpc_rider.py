@@ -38,11 +38,12 @@ def _ride(dog, duration: float, rider: MpcRider | None = None):
 
 
 def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog) -> None:
-    """With ``plan_latency`` 1 the MPC solves in a thread of its own: a plan takes over one
-    tick after the state it starts from (the first at once), timed from that state; the
-    ticks between follow the previous plan. The ride does not depend on how fast the thread
-    runs: two rides are the same, bit for bit. The Hovershoes ride so; the skateboard and
-    the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
+    """With ``plan_latency`` 1 the MPC builds and solves its problems in a process of its
+    own: a plan takes over one tick after the state it starts from (the first at once),
+    timed from that state; the ticks between follow the previous plan. The ride does not
+    depend on how fast the process runs, nor on where the MPC runs (the process, the solver
+    thread, the tick): the rides are the same, bit for bit. The Hovershoes ride so; the
+    skateboard and the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
     assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
     assert load_mpc_pair("cassie", "segway").plan_latency == 0
     assert MpcRider(dog, "skateboard").plan_latency == 0
@@ -52,23 +53,29 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     taken: list[tuple[int, float, float]] = []  # tick, time of its state, plan's time
     adopt = rider._adopt
 
+    forked: list[bool] = []
+
     def adopting(solve, built):
         adopt(solve, built)
         taken.append((rider._tick, solve.time, rider._plan_time))
+        forked.append(rider._worker is not None)
 
     rider._adopt = adopting
     first, _ = _ride(dog, 0.2, rider)
     assert first.status == "ok"
+    assert rider.off_tick == "process" and forked[1:] == [True] * (len(forked) - 1)
+    assert rider._worker is None  # ended with the ride
     assert [tick for tick, *_ in taken] == [0] + [k * MPC_DIVIDER + 1 for k in range(1, len(taken))]
     assert all(state == plan for _, state, plan in taken)
     assert len(rider.mpc_tick_ms) == len(taken) and rider.mpc_loop_seconds > 0.0
     again, _ = _ride(dog, 0.2, MpcRider(dog, "skateboard", plan_latency=1))
     np.testing.assert_array_equal(again.log["qpos"], first.log["qpos"])
-    in_tick = MpcRider(dog, "skateboard", plan_latency=1)
-    in_tick.off_tick = False  # built and solved in the tick, taken up a tick later
-    inline, _ = _ride(dog, 0.2, in_tick)
-    np.testing.assert_array_equal(inline.log["qpos"], first.log["qpos"])
-    assert in_tick.summary()["mpc_solves"] == rider.summary()["mpc_solves"]
+    for where in ("tick", "thread"):  # built and solved there, taken up a tick later
+        other = MpcRider(dog, "skateboard", plan_latency=1)
+        other.off_tick = where
+        ridden, _ = _ride(dog, 0.2, other)
+        np.testing.assert_array_equal(ridden.log["qpos"], first.log["qpos"])
+        assert other.summary()["mpc_solves"] == rider.summary()["mpc_solves"]
     at_once, _ = _ride(dog, 0.2)
     assert at_once.status == "ok"
     assert np.abs(at_once.log["qpos"][-1] - first.log["qpos"][-1]).max() > 0.0  # it is used
@@ -229,7 +236,7 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
 
     def planning(solve, built):  # each plan as it takes over, with its problem
         adopt(solve, built)
-        problem, plan = built.started.problem, rider._plan
+        problem, plan = built.problem, rider._plan
         x0, reference = problem.initial_state, problem.state_reference[0]
         steps.append(
             (

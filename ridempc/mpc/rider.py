@@ -110,10 +110,11 @@ from ridempc.mpc.pairs import load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.qp import SolveOutcome, StartedSolve
+from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
+from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
@@ -157,8 +158,10 @@ class _BuildInputs(NamedTuple):
     reference's time [s], the mapped state, the rates' drift (or None), the tick's time
     [s], the board's speed [m/s], the commanded roll at the horizon's nodes [rad], the
     turn over its steps [rad/s], the turn so far [rad], whether the rider coasts, whether
-    the manoeuvre switched at this tick, the lean loop (a copy, or None) and the shoes'
-    observer (frozen, or None)."""
+    the manoeuvre switched at this tick, the lean loop (a copy, or None), the shoes'
+    observer (frozen, or None), the manoeuvre's kind and target, the plan in force's
+    first input (or None), the contacts of the last MPC step, and the reference tracked
+    when it changed at this tick (else None)."""
 
     t_ref: float
     x0: Array
@@ -172,15 +175,22 @@ class _BuildInputs(NamedTuple):
     switched: bool
     lean: LeanSteering | None
     shoes: ShoeObserver | None
+    manoeuvre: tuple[str, float]
+    first_input: Array | None
+    contacts: tuple[Contact, ...]
+    reference: MotionReference | None
 
 
 class _Built(NamedTuple):
-    """An MPC problem built, started and run (:meth:`MpcRider._build_and_run`): the
-    started QP, OSQP's outcome and the time spent building the problem [s]."""
+    """An MPC problem built and solved (:meth:`MpcRider._build_and_run`): its plan, the
+    contacts of its first step, the time spent building it [s], the QP's failures so far
+    and the problem (None when sent back from the solver process without it)."""
 
-    started: StartedSolve
-    outcome: SolveOutcome
+    plan: Plan
+    contacts: tuple[Contact, ...]
     build_s: float
+    failures: int
+    problem: MpcProblem | None
 
 
 class _PendingSolve(NamedTuple):
@@ -191,7 +201,7 @@ class _PendingSolve(NamedTuple):
     frame: PlanarFrame
     time: float
     due: int
-    future: Future[_Built] | None = None
+    reply: Future[_Built] | Reply[_Built] | None = None
 
 
 @cache
@@ -254,10 +264,15 @@ class MpcRider(Controller):
     """
 
     rate_hz = 500.0
-    # Whether a solve with a ``plan_latency`` builds its problem and solves it in the solver
-    # thread beside the loop (else in its tick, its plan still taken up ``plan_latency``
-    # ticks later: the same ride, bit for bit).
-    off_tick: bool = True
+    # Where a solve with a ``plan_latency`` is built and run (its plan taken up
+    # ``plan_latency`` ticks on whichever: the same ride, bit for bit): ``process``, a
+    # child process on the other core (mpc/solver_process.py; a thread where the process
+    # cannot fork: in a sweep's worker, off the main thread), ``thread``, the solver
+    # thread (whose Python holds the loop's lock: little gained), ``tick``, in its tick.
+    off_tick: str = "process"
+    # Whether the solver process sends each problem back with its plan (the bench keeps
+    # them; the ride needs the plan only).
+    keeps_problems: bool = False
 
     def __init__(
         self,
@@ -419,6 +434,9 @@ class MpcRider(Controller):
         self._mpc_qp_ms: list[float] = []  # each tick's QP: updating it and solving it
         self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
         self._pending: _PendingSolve | None = None
+        self._worker: SolverProcess[_BuildInputs, _Built] | None = None
+        self._sent_reference: MotionReference | None = None  # the last one the build got
+        self._mpc_failures = 0  # the MPC's fallbacks, as of the last plan taken up
         self._wbc_ms: list[float] = []
         self._diagnostics: dict[str, float] = {}
 
@@ -545,7 +563,6 @@ class MpcRider(Controller):
             # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
             # turn back at once and fell in the push)
             self._anchor(estimate, now, self._turned if switched else 0.0)
-            self._blend = None
         else:
             switched = False
         t_ref = self.manoeuvre.reference_time(now)
@@ -585,40 +602,69 @@ class MpcRider(Controller):
             switched,
             copy.copy(self.lean),
             self.shoes.frozen() if self.shoes is not None else None,
+            (self.manoeuvre.kind, self.manoeuvre.target),
+            self._plan.first_input if self._plan is not None else None,
+            self._contacts,
+            None if self.mpc.reference is self._sent_reference else self.mpc.reference,
         )
-        pending = _PendingSolve(  # the frame the plan is in: the map's moves on at the next
-            self.map.frame, now, self._tick + self.plan_latency  # tick, the plan only when
-        )  # this one takes over
+        self._sent_reference = self.mpc.reference
+        # the frame the plan is in: the map's moves on at the next tick, the plan only
+        # when this one takes over
+        pending = _PendingSolve(self.map.frame, now, self._tick + self.plan_latency)
         if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
             self._adopt(pending, self._build_and_run(inputs))
-        elif not self.off_tick:
-            future: Future[_Built] = Future()
-            future.set_result(self._build_and_run(inputs))
-            self._pending = pending._replace(future=future)
         else:
-            self._pending = pending._replace(
-                future=_solver_thread().submit(partial(self._build_and_run, inputs))
-            )
+            self._pending = pending._replace(reply=self._submit(inputs))
         self._mpc_main_s += time.perf_counter() - started
+
+    def _submit(self, inputs: _BuildInputs) -> Future[_Built] | Reply[_Built]:
+        """The build and solve of ``inputs`` started where ``off_tick`` says."""
+        where = self.off_tick
+        if where == "process" and (self._worker is not None or forks()):
+            if self._worker is None:
+                self._worker = SolverProcess(self._build_in_process)
+            return self._worker.submit(inputs)
+        if where in ("process", "thread"):
+            return _solver_thread().submit(partial(self._build_and_run, inputs))
+        future: Future[_Built] = Future()
+        future.set_result(self._build_and_run(inputs))
+        return future
+
+    def close(self) -> None:
+        """End the MPC's solver process, if one was started (at the end of a ride)."""
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
 
     def _build_and_run(self, inputs: _BuildInputs) -> _Built:
         """The MPC problem of one tick built from ``inputs`` (and the build's own state:
-        the QP's warm start, a re-push's blend, the crouch's start, the static shifts
-        kept by key), started and solved; in the control loop's thread or in the solver
-        thread beside it (``off_tick``), the same either way."""
+        the QP and its warm start, a re-push's blend, the crouch's start, the static
+        shifts kept by key) and solved; in the loop's tick, the solver thread or the
+        solver process (``off_tick``), the same either way."""
         started = time.perf_counter()
+        if inputs.reference is not None:
+            self.mpc.reference = inputs.reference
         problem = self._shaped(self.mpc.problem(inputs.t_ref, inputs.x0, inputs.drift), inputs)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         build = time.perf_counter() - started
-        begun = self.mpc.qp.start(problem)
-        return _Built(begun, self.mpc.qp.run(), build)
+        qp = self.mpc.qp
+        plan = qp.finish(qp.start(problem), qp.run())
+        return _Built(plan, problem.contacts[0], build, qp.failures, problem)
+
+    def _build_in_process(self, inputs: _BuildInputs) -> _Built:
+        """:meth:`_build_and_run` in the solver process, its reply without the problem
+        (a few hundred kB to send and read back) unless ``keeps_problems``."""
+        built = self._build_and_run(inputs)
+        return built if self.keeps_problems else built._replace(problem=None)
 
     def _shaped(self, problem: MpcProblem, inputs: _BuildInputs) -> MpcProblem:
         """``problem`` shaped by the rider's steps: coasting, the commanded roll, a
         re-push's blend, the turn, the crouch, the lean, the shoes' lines and drags and
         the swing's held forces."""
         names, t_ref, speed = self.layout.names, inputs.t_ref, inputs.speed
+        if inputs.switched:  # a re-push's blend starts again
+            self._blend = None
         # A re-push before its first push (while its blend runs) coasts too, its speeds
         # scaled to the board's: the entry's planned body speed, faster than a deck that
         # slows more than its model, had the MPC push the body forward and brake the deck.
@@ -639,7 +685,7 @@ class MpcRider(Controller):
         lean = inputs.lean
         if lean is not None:
             if lean.offset != 0.0:
-                balance = self._lean_balance(t_ref)
+                balance = self._lean_balance(t_ref, inputs.manoeuvre)
                 problem = lean.lean(problem, names["com_y"], names["vy"], balance)
             problem = lean.turn(problem, names)
         if inputs.shoes is not None:  # each shoe's heading turned towards its line, its
@@ -648,24 +694,23 @@ class MpcRider(Controller):
             states = inputs.shoes.shift_reference(states, columns)
             c = inputs.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
-        return self._held_forces(problem)
+        return self._held_forces(problem, inputs.first_input, inputs.contacts)
 
     def _adopt_pending(self) -> None:
         """The pending solve's plan taken up, once its tick has come (waiting for it if
         the solver is still at it)."""
         solve, self._pending = self._pending, None
-        assert solve is not None and solve.future is not None
+        assert solve is not None and solve.reply is not None
         started = time.perf_counter()
-        self._adopt(solve, solve.future.result())
+        self._adopt(solve, solve.reply.result())
         self._mpc_main_s += time.perf_counter() - started
 
     def _adopt(self, solve: _PendingSolve, built: _Built) -> None:
         """The plan of ``solve`` (its problem ``built`` and solved) in force from this tick
         on, timed from the state it was solved from."""
-        assert self.mpc.qp is not None
-        problem = built.started.problem
-        self._contacts, self._last_problem = problem.contacts[0], problem
-        plan = self.mpc.qp.finish(built.started, built.outcome)
+        plan = built.plan
+        self._contacts, self._last_problem = built.contacts, built.problem
+        self._mpc_failures = built.failures
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
@@ -673,42 +718,40 @@ class MpcRider(Controller):
         if self.force_filter is not None:
             plan = plan._replace(first_input=self.force_filter(plan.first_input, solve.time))
         self._plan, self._plan_time, self._plan_frame = plan, solve.time, solve.frame
-        self._set_support(problem.contacts[0])
+        self._set_support(built.contacts)
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
 
-    def _lean_balance(self, t_ref: float) -> StaticShift:
+    def _lean_balance(self, t_ref: float, manoeuvre: tuple[str, float]) -> StaticShift:
         """How the reference's forces move per metre of the lean's offset, found once per
         manoeuvre at its first lean (the stance does not change over a speed change on
         the Segway; found at every tick of a ramp, where the reference moves, it took
         1.2 ms of the MPC tick)."""
-        key = (self.manoeuvre.kind, self.manoeuvre.target)
+        key = manoeuvre  # (kind, target)
         if self._lean_shift is None or self._lean_shift[0] != key:
             names, rider = self.layout.names, self.layout.rider_states
             self._lean_shift = (key, self.mpc.static_shift(t_ref, names["com_y"], rider))
         return self._lean_shift[1]
 
-    def _held_forces(self, problem: MpcProblem) -> MpcProblem:
-        """While a foot swings and no contact changes from the last tick, the first step's
-        deck forces drawn to the last plan's (:mod:`~ridempc.mpc.input_rate`), with the
-        pair's tolerance :attr:`~ridempc.mpc.pairs.MpcPair.swing_force_step`."""
+    def _held_forces(
+        self, problem: MpcProblem, first_input: Array | None, last: tuple[Contact, ...]
+    ) -> MpcProblem:
+        """While a foot swings and no contact changes from the last tick (``last``), the
+        first step's deck forces drawn to the last plan's (its ``first_input``;
+        :mod:`~ridempc.mpc.input_rate`), with the pair's tolerance
+        :attr:`~ridempc.mpc.pairs.MpcPair.swing_force_step`."""
         step, contacts = self.pair.swing_force_step, problem.contacts[0]
-        if (
-            step is None
-            or self._plan is None
-            or Contact.SWING not in contacts
-            or self._contacts != contacts
-        ):
+        if step is None or first_input is None or Contact.SWING not in contacts or last != contacts:
             return problem
         index = self.mpc.reference.force_index
         weights = np.zeros(problem.nu)
         for i, contact in enumerate(contacts):
             if contact is Contact.BOARD:
                 weights[index[i]] = 1.0 / step**2
-        return hold_first_input(problem, self._plan.first_input, weights)
+        return hold_first_input(problem, first_input, weights)
 
     def _roll_drift(
         self, x0: Array, now: float, balancing: bool, estimate: EstimatedState
@@ -1001,10 +1044,9 @@ class MpcRider(Controller):
             if values:
                 ms = np.asarray(values)
                 out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
-        qp = self.mpc.qp
         out["mpc_solves"] = len(self._mpc_ms)
         out["speed_preview_s"] = self._speed_preview_s()
-        out["mpc_fallbacks"] = int(qp.failures) if qp is not None else 0
+        out["mpc_fallbacks"] = self._mpc_failures
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries
         out["wbc_daqp_solves"] = self.wbc.qp.fallbacks
