@@ -24,7 +24,7 @@ import time
 import weakref
 from collections.abc import Callable
 from multiprocessing.connection import Connection
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic, NoReturn, TypeVar
 
 from ridempc.errors import RidempcError
 from ridempc.interrupts import worker_started
@@ -84,7 +84,10 @@ class SolverProcess(Generic[I, R]):
         if self._conn is None:
             self._start()
         assert self._conn is not None
-        self._conn.send(item)
+        try:
+            self._conn.send(item)
+        except OSError as exc:  # the child is gone
+            self._ended(exc)
         return Reply(self)
 
     def _start(self) -> None:
@@ -106,11 +109,14 @@ class SolverProcess(Generic[I, R]):
         try:
             ok, value = self._conn.recv()
         except (EOFError, OSError) as exc:
-            self.close()
-            raise RidempcError(f"the MPC's solver process ended ({exc!r})") from None
+            self._ended(exc)
         if not ok:
             raise value
         return value
+
+    def _ended(self, exc: BaseException) -> NoReturn:
+        self.close()
+        raise RidempcError(f"the MPC's solver process ended ({exc!r})") from None
 
     def close(self) -> None:
         """End the child (its pipe closed, then killed if still there)."""
