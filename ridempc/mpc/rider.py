@@ -10,8 +10,8 @@ Every 2 ms (500 Hz) the rider
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
    (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes the problem is built and
-   OSQP iterates in a thread of its own, as the robots run their MPC beside their WBC, from
-   what the tick sends it (:meth:`MpcRider._build_and_run`), and the plan takes over one
+   solved in a process of its own, as the robots run their MPC beside their WBC, from what
+   the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``), and the plan takes over one
    tick, 2 ms, after the state it starts from, waited for then whatever the machine, the
    tick between following the previous plan in its own library frame: the pair's
    ``plan_latency``) on the manoeuvre the command asks for
