@@ -13,7 +13,7 @@ from ridempc.boards import load_board
 from ridempc.cli import main
 from ridempc.estimation import BoardEstimate, EstimatedState
 from ridempc.mpc.pairs import load_mpc_pair
-from ridempc.mpc.rider import MPC_DIVIDER, WBC_GRACE_TICKS, MpcRider
+from ridempc.mpc.rider import MPC_DIVIDER, PROCESS_MIN_LATENCY, WBC_GRACE_TICKS, MpcRider
 from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S, StateMap
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -38,11 +38,12 @@ def _ride(dog, duration: float, rider: MpcRider | None = None):
 
 
 def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog) -> None:
-    """With ``plan_latency`` 1 the MPC builds and solves its problems in a process of its
-    own: a plan takes over one tick after the state it starts from (the first at once),
-    timed from that state; the ticks between follow the previous plan. The ride does not
-    depend on how fast the process runs, nor on where the MPC runs (the process, the solver
-    thread, the tick): the rides are the same, bit for bit. The Hovershoes ride so; the
+    """With ``plan_latency`` 1 the MPC builds and solves its problems in a thread of its
+    own (from ``PROCESS_MIN_LATENCY`` ticks on in a process): a plan takes over one tick
+    after the state it starts from (the first at once), timed from that state; the ticks
+    between follow the previous plan. The ride does not depend on how fast the thread or
+    the process runs, nor on where the MPC runs (the process, the thread, the tick): the
+    rides are the same, bit for bit. The Hovershoes ride so; the
     skateboard and the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
     assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
     assert load_mpc_pair("cassie", "segway").plan_latency == 0
@@ -63,8 +64,7 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     rider._adopt = adopting
     first, _ = _ride(dog, 0.2, rider)
     assert first.status == "ok"
-    assert rider.off_tick == "process" and forked[1:] == [True] * (len(forked) - 1)
-    assert rider._worker is None  # ended with the ride
+    assert rider.off_tick == "process" and not any(forked)  # a thread at 1 tick
     assert [tick for tick, *_ in taken] == [0] + [k * MPC_DIVIDER + 1 for k in range(1, len(taken))]
     assert all(state == plan for _, state, plan in taken)
     assert len(rider.mpc_tick_ms) == len(taken) and rider.mpc_loop_seconds > 0.0
@@ -76,6 +76,17 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
         ridden, _ = _ride(dog, 0.2, other)
         np.testing.assert_array_equal(ridden.log["qpos"], first.log["qpos"])
         assert other.summary()["mpc_solves"] == rider.summary()["mpc_solves"]
+    later = MpcRider(dog, "skateboard", plan_latency=PROCESS_MIN_LATENCY)
+    forked.clear()
+    later._adopt = lambda solve, built: (
+        MpcRider._adopt(later, solve, built),
+        forked.append(later._worker is not None),
+    )
+    in_process, _ = _ride(dog, 0.2, later)
+    assert forked[1:] == [True] * (len(forked) - 1) and later._worker is None  # ended
+    in_tick = MpcRider(dog, "skateboard", plan_latency=PROCESS_MIN_LATENCY)
+    in_tick.off_tick = "tick"
+    np.testing.assert_array_equal(_ride(dog, 0.2, in_tick)[0].log["qpos"], in_process.log["qpos"])
     at_once, _ = _ride(dog, 0.2)
     assert at_once.status == "ok"
     assert np.abs(at_once.log["qpos"][-1] - first.log["qpos"][-1]).max() > 0.0  # it is used

@@ -151,6 +151,12 @@ UNREALISED_INPUTS: tuple[str, ...] = ("knee_bar",)
 # Consecutive WBC failures bridged with the last command before the safe hold (10 ms): one
 # QP that does not converge should not end a ride (the QP already retried it cold).
 WBC_GRACE_TICKS: int = 5
+# Least plan_latency [ticks] whose solves go to the solver process: at 1 the loop takes the
+# plan up after the next tick's simulation and estimate, about 0.5 ms after sending the
+# state, where the process builds and solves in 2.3 ms (Hovershoes, median) and the thread,
+# which overlaps OSQP's iterations with the loop (0.7 ms of building holds the lock), waits
+# less (docs/tuning.md).
+PROCESS_MIN_LATENCY: int = 2
 
 
 class _BuildInputs(NamedTuple):
@@ -266,9 +272,10 @@ class MpcRider(Controller):
     rate_hz = 500.0
     # Where a solve with a ``plan_latency`` is built and run (its plan taken up
     # ``plan_latency`` ticks on whichever: the same ride, bit for bit): ``process``, a
-    # child process on the other core (mpc/solver_process.py; a thread where the process
-    # cannot fork: in a sweep's worker, off the main thread), ``thread``, the solver
-    # thread (whose Python holds the loop's lock: little gained), ``tick``, in its tick.
+    # child process on the other core (mpc/solver_process.py) from PROCESS_MIN_LATENCY
+    # on, else, or where the process cannot fork (in a sweep's worker, off the main
+    # thread), the thread; ``thread``, the solver thread (its Python holds the loop's
+    # lock: only OSQP's iterations run beside the loop); ``tick``, in its tick.
     off_tick: str = "process"
     # Whether the solver process sends each problem back with its plan (the bench keeps
     # them; the ride needs the plan only).
@@ -620,7 +627,8 @@ class MpcRider(Controller):
     def _submit(self, inputs: _BuildInputs) -> Future[_Built] | Reply[_Built]:
         """The build and solve of ``inputs`` started where ``off_tick`` says."""
         where = self.off_tick
-        if where == "process" and (self._worker is not None or forks()):
+        process = where == "process" and self.plan_latency >= PROCESS_MIN_LATENCY
+        if process and (self._worker is not None or forks()):
             if self._worker is None:
                 self._worker = SolverProcess(self._build_in_process)
             return self._worker.submit(inputs)
