@@ -14,7 +14,7 @@ from ridempc.cli import main
 from ridempc.estimation import BoardEstimate, EstimatedState
 from ridempc.mpc.handover import RETURN_DWELL_S
 from ridempc.mpc.pairs import load_mpc_pair
-from ridempc.mpc.rider import MPC_DIVIDER, MpcRider
+from ridempc.mpc.rider import MPC_DIVIDER, PROCESS_MIN_LATENCY, MpcRider
 from ridempc.mpc.state_map import ALONG_SLACK, HEADING_FILTER_S, StateMap
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -39,11 +39,13 @@ def _ride(dog, duration: float, rider: MpcRider | None = None):
 
 
 def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog) -> None:
-    """With ``plan_latency`` 1 the MPC solves in a thread of its own: a plan takes over one
-    tick after the state it starts from (the first at once), timed from that state; the
-    ticks between follow the previous plan. The ride does not depend on how fast the thread
-    runs: two rides are the same, bit for bit. The Hovershoes ride so; the skateboard and
-    the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
+    """With ``plan_latency`` 1 the MPC builds and solves its problems in a thread of its
+    own (from ``PROCESS_MIN_LATENCY`` ticks on in a process): a plan takes over one tick
+    after the state it starts from (the first at once), timed from that state; the ticks
+    between follow the previous plan. The ride does not depend on how fast the thread or
+    the process runs, nor on where the MPC runs (the process, the thread, the tick): the
+    rides are the same, bit for bit. The Hovershoes ride so; the
+    skateboard and the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
     assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
     assert load_mpc_pair("cassie", "segway").plan_latency == 0
     assert MpcRider(dog, "skateboard").plan_latency == 0
@@ -53,18 +55,39 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     taken: list[tuple[int, float, float]] = []  # tick, time of its state, plan's time
     adopt = rider._adopt
 
-    def adopting(solve, outcome):
-        adopt(solve, outcome)
+    forked: list[bool] = []
+
+    def adopting(solve, built):
+        adopt(solve, built)
         taken.append((rider._tick, solve.time, rider._plan_time))
+        forked.append(rider._worker is not None)
 
     rider._adopt = adopting
     first, _ = _ride(dog, 0.2, rider)
     assert first.status == "ok"
+    assert rider.off_tick == "process" and not any(forked)  # a thread at 1 tick
     assert [tick for tick, *_ in taken] == [0] + [k * MPC_DIVIDER + 1 for k in range(1, len(taken))]
     assert all(state == plan for _, state, plan in taken)
     assert len(rider.mpc_tick_ms) == len(taken) and rider.mpc_loop_seconds > 0.0
     again, _ = _ride(dog, 0.2, MpcRider(dog, "skateboard", plan_latency=1))
     np.testing.assert_array_equal(again.log["qpos"], first.log["qpos"])
+    for where in ("tick", "thread"):  # built and solved there, taken up a tick later
+        other = MpcRider(dog, "skateboard", plan_latency=1)
+        other.off_tick = where
+        ridden, _ = _ride(dog, 0.2, other)
+        np.testing.assert_array_equal(ridden.log["qpos"], first.log["qpos"])
+        assert other.summary()["mpc_solves"] == rider.summary()["mpc_solves"]
+    later = MpcRider(dog, "skateboard", plan_latency=PROCESS_MIN_LATENCY)
+    forked.clear()
+    later._adopt = lambda solve, built: (
+        MpcRider._adopt(later, solve, built),
+        forked.append(later._worker is not None),
+    )
+    in_process, _ = _ride(dog, 0.2, later)
+    assert forked[1:] == [True] * (len(forked) - 1) and later._worker is None  # ended
+    in_tick = MpcRider(dog, "skateboard", plan_latency=PROCESS_MIN_LATENCY)
+    in_tick.off_tick = "tick"
+    np.testing.assert_array_equal(_ride(dog, 0.2, in_tick)[0].log["qpos"], in_process.log["qpos"])
     at_once, _ = _ride(dog, 0.2)
     assert at_once.status == "ok"
     assert np.abs(at_once.log["qpos"][-1] - first.log["qpos"][-1]).max() > 0.0  # it is used
@@ -233,9 +256,9 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
     steps: list[tuple] = []  # t, wx0, planned wx1, board speed, its reference, support
     adopt = rider._adopt
 
-    def planning(solve, outcome):  # each plan as it takes over, with its problem
-        adopt(solve, outcome)
-        problem, plan = solve.started.problem, rider._plan
+    def planning(solve, built):  # each plan as it takes over, with its problem
+        adopt(solve, built)
+        problem, plan = built.problem, rider._plan
         x0, reference = problem.initial_state, problem.state_reference[0]
         steps.append(
             (

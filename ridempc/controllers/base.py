@@ -54,6 +54,10 @@ class Controller(ABC):
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         """One control tick."""
 
+    def close(self) -> None:  # noqa: B027 - optional hook
+        """Called once the ride has ended (also when it fails or is interrupted): end
+        whatever the controller started beside the loop (the MPC's solver process)."""
+
     def diagnostics(self) -> dict[str, float]:
         """Scalars to log at this tick (solve times, modes, ...)."""
         return {}

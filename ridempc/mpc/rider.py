@@ -9,8 +9,9 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes OSQP iterates in a thread
-   of its own, as the robots run their MPC beside their WBC, and the plan takes over one
+   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes the problem is built and
+   solved in a process of its own, as the robots run their MPC beside their WBC, from what
+   the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``), and the plan takes over one
    tick, 2 ms, after the state it starts from, waited for then whatever the machine, the
    tick between following the previous plan in its own library frame: the pair's
    ``plan_latency``) on the manoeuvre the command asks for
@@ -77,11 +78,12 @@ finite command are the joints held where they are (``safe_hold``).
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from concurrent.futures import Future
 from dataclasses import replace
-from functools import cache
+from functools import cache, partial
 from typing import Any, NamedTuple, cast
 
 import numpy as np
@@ -120,10 +122,11 @@ from ridempc.mpc.pairs import check_library_names, load_mpc_pair
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.qp import SolveOutcome, StartedSolve
+from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
+from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
@@ -155,20 +158,65 @@ MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step
 # The law the ride is handed to when the MPC or its QP fails (ridempc.mpc.handover): the
 # pair's PD baseline, which balances every pair from the same sensors.
 BACKUP_LAW: str = "pd"
+# Least plan_latency [ticks] whose solves go to the solver process: at 1 the loop takes the
+# plan up after the next tick's simulation and estimate, about 0.5 ms after sending the
+# state, where the process builds and solves in 2.3 ms (Hovershoes, median) and the thread,
+# which overlaps OSQP's iterations with the loop (0.7 ms of building holds the lock), waits
+# less (docs/tuning.md).
+PROCESS_MIN_LATENCY: int = 2
+
+
+class _BuildInputs(NamedTuple):
+    """What an MPC problem is built from, as the loop has it at the MPC's tick: the
+    reference's time [s], the mapped state, the rates' drift (or None), the tick's time
+    [s], the board's speed [m/s], the commanded roll at the horizon's nodes [rad], the
+    turn over its steps [rad/s], the turn so far [rad], whether the rider coasts, whether
+    the manoeuvre switched at this tick, the lean loop (a copy, or None), the shoes'
+    observer (frozen, or None), the manoeuvre's kind and target, the plan in force's
+    first input (or None), the contacts of the last MPC step, and the reference tracked
+    when it changed at this tick (else None)."""
+
+    t_ref: float
+    x0: Array
+    drift: Array | None
+    now: float
+    speed: float
+    roll: Array
+    turn: Array
+    turned: float
+    coasting: bool
+    switched: bool
+    lean: LeanSteering | None
+    shoes: ShoeObserver | None
+    manoeuvre: tuple[str, float]
+    first_input: Array | None
+    contacts: tuple[Contact, ...]
+    reference: MotionReference | None
+
+
+class _Built(NamedTuple):
+    """An MPC problem built and solved (:meth:`MpcRider._build_and_run`): its plan, the
+    contacts of its first step, the time spent building it [s], the QP's failures so far,
+    the problem (None when sent back from the solver process without it) and how far its
+    initial state lies from its reference (:func:`~ridempc.mpc.handover.deviation`) [-]."""
+
+    plan: Plan
+    contacts: tuple[Contact, ...]
+    build_s: float
+    failures: int
+    problem: MpcProblem | None
+    deviation: float
 
 
 class _PendingSolve(NamedTuple):
-    """An MPC solve under way: the started QP, the library frame its problem is in, the
-    time of the state it starts from [s], the tick its plan takes over, the time spent
-    building the problem [s], and the solver thread's future (None when solved in the
-    tick)."""
+    """An MPC solve under way: the library frame its problem is in, the time of the state
+    it starts from [s], the tick its plan takes over, and its built and solved problem to
+    come (None when built and solved in the tick)."""
 
-    started: StartedSolve
     frame: PlanarFrame
     time: float
     due: int
-    build_s: float
-    future: Future[SolveOutcome] | None = None
+    reply: Future[_Built] | Reply[_Built] | None = None
 
 
 def _backup(robot: Robot, board: str) -> Controller:
@@ -240,6 +288,16 @@ class MpcRider(Controller):
     """
 
     rate_hz = 500.0
+    # Where a solve with a ``plan_latency`` is built and run (its plan taken up
+    # ``plan_latency`` ticks on whichever: the same ride, bit for bit): ``process``, a
+    # child process on the other core (mpc/solver_process.py) from PROCESS_MIN_LATENCY
+    # on, else, or where the process cannot fork (in a sweep's worker, off the main
+    # thread), the thread; ``thread``, the solver thread (its Python holds the loop's
+    # lock: only OSQP's iterations run beside the loop); ``tick``, in its tick.
+    off_tick: str = "process"
+    # Whether the solver process sends each problem back with its plan (the bench keeps
+    # them; the ride needs the plan only).
+    keeps_problems: bool = False
 
     def __init__(
         self,
@@ -416,6 +474,9 @@ class MpcRider(Controller):
         self._mpc_qp_ms: list[float] = []  # each tick's QP: updating it and solving it
         self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
         self._pending: _PendingSolve | None = None
+        self._worker: SolverProcess[_BuildInputs, _Built] | None = None
+        self._sent_reference: MotionReference | None = None  # the last one the build got
+        self._mpc_failures = 0  # the MPC's fallbacks, as of the last plan taken up
         self._wbc_ms: list[float] = []
         self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
@@ -571,7 +632,6 @@ class MpcRider(Controller):
             # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
             # turn back at once and fell in the push)
             self._anchor(estimate, now, self._turned if switched else 0.0)
-            self._blend = None
         else:
             switched = False
         t_ref = self.manoeuvre.reference_time(now)
@@ -597,119 +657,176 @@ class MpcRider(Controller):
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
-        problem = self.mpc.problem(t_ref, x0, drift)
+            self._diagnostics["lean_offset"] = self.lean.offset
+        inputs = _BuildInputs(  # what the loop's state says now, copied: the build may run
+            t_ref,  # beside the loop's next ticks, which move the shoes' observer on
+            x0,
+            drift,
+            now,
+            speed,
+            roll,
+            turn,
+            self._turned,
+            coasting,
+            switched,
+            copy.copy(self.lean),
+            self.shoes.frozen() if self.shoes is not None else None,
+            (self.manoeuvre.kind, self.manoeuvre.target),
+            self._plan.first_input if self._plan is not None else None,
+            self._contacts,
+            None if self.mpc.reference is self._sent_reference else self.mpc.reference,
+        )
+        self._sent_reference = self.mpc.reference
+        # the frame the plan is in: the map's moves on at the next tick, the plan only
+        # when this one takes over
+        pending = _PendingSolve(self.map.frame, now, self._tick + self.plan_latency)
+        if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
+            self._adopt(pending, self._build_and_run(inputs))
+        else:
+            self._pending = pending._replace(reply=self._submit(inputs))
+        self._mpc_main_s += time.perf_counter() - started
+
+    def _submit(self, inputs: _BuildInputs) -> Future[_Built] | Reply[_Built]:
+        """The build and solve of ``inputs`` started where ``off_tick`` says."""
+        where = self.off_tick
+        process = where == "process" and self.plan_latency >= PROCESS_MIN_LATENCY
+        if process and (self._worker is not None or forks()):
+            if self._worker is None:
+                self._worker = SolverProcess(self._build_in_process)
+            return self._worker.submit(inputs)
+        if where in ("process", "thread"):
+            return _solver_thread().submit(partial(self._build_and_run, inputs))
+        future: Future[_Built] = Future()
+        future.set_result(self._build_and_run(inputs))
+        return future
+
+    def close(self) -> None:
+        """End the MPC's solver process, if one was started (at the end of a ride)."""
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
+
+    def _build_and_run(self, inputs: _BuildInputs) -> _Built:
+        """The MPC problem of one tick built from ``inputs`` (and the build's own state:
+        the QP and its warm start, a re-push's blend, the crouch's start, the static
+        shifts kept by key) and solved; in the loop's tick, the solver thread or the
+        solver process (``off_tick``), the same either way."""
+        started = time.perf_counter()
+        if inputs.reference is not None:
+            self.mpc.reference = inputs.reference
+        problem = self._shaped(self.mpc.problem(inputs.t_ref, inputs.x0, inputs.drift), inputs)
+        if self.mpc.qp is None:
+            self.mpc.qp = self.mpc.build_qp(problem)
+        build = time.perf_counter() - started
+        qp = self.mpc.qp
+        plan = qp.finish(qp.start(problem), qp.run())
+        gap = deviation(problem.initial_state, problem.state_reference[0], problem.state_weights)
+        return _Built(plan, problem.contacts[0], build, qp.failures, problem, gap)
+
+    def _build_in_process(self, inputs: _BuildInputs) -> _Built:
+        """:meth:`_build_and_run` in the solver process, its reply without the problem
+        (a few hundred kB to send and read back) unless ``keeps_problems``."""
+        built = self._build_and_run(inputs)
+        return built if self.keeps_problems else built._replace(problem=None)
+
+    def _shaped(self, problem: MpcProblem, inputs: _BuildInputs) -> MpcProblem:
+        """``problem`` shaped by the rider's steps: coasting, the commanded roll, a
+        re-push's blend, the turn, the crouch, the lean, the shoes' lines and drags and
+        the swing's held forces."""
+        names, t_ref, speed = self.layout.names, inputs.t_ref, inputs.speed
+        if inputs.switched:  # a re-push's blend starts again
+            self._blend = None
         # A re-push before its first push (while its blend runs) coasts too, its speeds
         # scaled to the board's: the entry's planned body speed, faster than a deck that
         # slows more than its model, had the MPC push the body forward and brake the deck.
-        if coasting or self._blend is not None:
+        if inputs.coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
         balance = None
-        if self.selector.commands_roll(names, roll):
+        if self.selector.commands_roll(names, inputs.roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
-        problem = self.selector.with_command(problem, names, roll, balance)
-        if switched:
+        problem = self.selector.with_command(problem, names, inputs.roll, balance)
+        if inputs.switched:
             self._blend = SwitchBlend.at_switch(problem, self.mpc.reference, self.layout, t_ref)
         if self._blend is not None:
             problem = self._blend(problem, t_ref)
             self._blend = None if self._blend.done(t_ref) else self._blend
-        problem = self.selector.with_turn(problem, self.layout, turn, self._turned)
+        problem = self.selector.with_turn(problem, self.layout, inputs.turn, inputs.turned)
         if self.crouch is not None:
-            problem = self.crouch.lower(problem, names["com_z"], now)
-        if self.lean is not None:
-            if self.lean.offset != 0.0:
-                balance = self._lean_balance(t_ref)
-                problem = self.lean.lean(problem, names["com_y"], names["vy"], balance)
-            problem = self.lean.turn(problem, names)
-            self._diagnostics["lean_offset"] = self.lean.offset
-        if self.shoes is not None:  # each shoe's heading turned towards its line, its
+            problem = self.crouch.lower(problem, names["com_z"], inputs.now)
+        lean = inputs.lean
+        if lean is not None:
+            if lean.offset != 0.0:
+                balance = self._lean_balance(t_ref, inputs.manoeuvre)
+                problem = lean.lean(problem, names["com_y"], names["vy"], balance)
+            problem = lean.turn(problem, names)
+        if inputs.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
             states = problem.state_reference
             if self._guidance:
                 states = steer_onto_lines(states, problem.initial_state, columns)
-            states = self.shoes.shift_reference(states, columns)
-            c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
+            states = inputs.shoes.shift_reference(states, columns)
+            c = inputs.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
-        problem = self._held_forces(problem)
-        self._deviation = deviation(
-            problem.initial_state, problem.state_reference[0], problem.state_weights
-        )
-        self._diagnostics["mpc_deviation"] = self._deviation
-        self._contacts = problem.contacts[0]
-        if self.mpc.qp is None:
-            self.mpc.qp = self.mpc.build_qp(problem)
-        self._last_problem = problem
-        build = time.perf_counter() - started
-        solve = _PendingSolve(  # the frame the plan is in: the map's moves on at the next
-            self.mpc.qp.start(problem),  # tick, the plan only when this one takes over
-            self.map.frame,
-            now,
-            self._tick + self.plan_latency,
-            build,
-        )
-        if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
-            self._adopt(solve, self.mpc.qp.run())
-        else:
-            future = _solver_thread().submit(self.mpc.qp.run)
-            self._pending = solve._replace(future=future)
-        self._mpc_main_s += time.perf_counter() - started
+        return self._held_forces(problem, inputs.first_input, inputs.contacts)
 
     def _adopt_pending(self) -> None:
         """The pending solve's plan taken up, once its tick has come (waiting for it if
         the solver is still at it)."""
         solve, self._pending = self._pending, None
-        assert solve is not None and solve.future is not None
+        assert solve is not None and solve.reply is not None
         started = time.perf_counter()
-        self._adopt(solve, solve.future.result())
+        self._adopt(solve, solve.reply.result())
         self._mpc_main_s += time.perf_counter() - started
 
-    def _adopt(self, solve: _PendingSolve, outcome: SolveOutcome) -> None:
-        """The plan of ``solve`` (OSQP's ``outcome``) in force from this tick on, timed
-        from the state it was solved from."""
-        assert self.mpc.qp is not None
-        plan = self.mpc.qp.finish(solve.started, outcome)
-        self._mpc_ms.append(1e3 * (solve.build_s + plan.solve_time))
+    def _adopt(self, solve: _PendingSolve, built: _Built) -> None:
+        """The plan of ``solve`` (its problem ``built`` and solved) in force from this tick
+        on, timed from the state it was solved from."""
+        plan = built.plan
+        self._contacts, self._last_problem = built.contacts, built.problem
+        self._mpc_failures = built.failures
+        self._deviation = built.deviation
+        self._diagnostics["mpc_deviation"] = built.deviation
+        self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
             raise RidempcError(f"MPC plan not finite (status {plan.status})")
         if self.force_filter is not None:
             plan = plan._replace(first_input=self.force_filter(plan.first_input, solve.time))
         self._plan, self._plan_time, self._plan_frame = plan, solve.time, solve.frame
-        self._set_support(solve.started.problem.contacts[0])
+        self._set_support(built.contacts)
         self._diagnostics.update(
             mpc_ms=self._mpc_ms[-1],
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
 
-    def _lean_balance(self, t_ref: float) -> StaticShift:
+    def _lean_balance(self, t_ref: float, manoeuvre: tuple[str, float]) -> StaticShift:
         """How the reference's forces move per metre of the lean's offset, found once per
         manoeuvre at its first lean (the stance does not change over a speed change on
         the Segway; found at every tick of a ramp, where the reference moves, it took
         1.2 ms of the MPC tick)."""
-        key = (self.manoeuvre.kind, self.manoeuvre.target)
+        key = manoeuvre  # (kind, target)
         if self._lean_shift is None or self._lean_shift[0] != key:
             names, rider = self.layout.names, self.layout.rider_states
             self._lean_shift = (key, self.mpc.static_shift(t_ref, names["com_y"], rider))
         return self._lean_shift[1]
 
-    def _held_forces(self, problem: MpcProblem) -> MpcProblem:
-        """While a foot swings and no contact changes from the last tick, the first step's
-        deck forces drawn to the last plan's (:mod:`~ridempc.mpc.input_rate`), with the
-        pair's tolerance :attr:`~ridempc.mpc.pairs.MpcPair.swing_force_step`."""
+    def _held_forces(
+        self, problem: MpcProblem, first_input: Array | None, last: tuple[Contact, ...]
+    ) -> MpcProblem:
+        """While a foot swings and no contact changes from the last tick (``last``), the
+        first step's deck forces drawn to the last plan's (its ``first_input``;
+        :mod:`~ridempc.mpc.input_rate`), with the pair's tolerance
+        :attr:`~ridempc.mpc.pairs.MpcPair.swing_force_step`."""
         step, contacts = self.pair.swing_force_step, problem.contacts[0]
-        if (
-            step is None
-            or self._plan is None
-            or Contact.SWING not in contacts
-            or self._contacts != contacts
-        ):
+        if step is None or first_input is None or Contact.SWING not in contacts or last != contacts:
             return problem
         index = self.mpc.reference.force_index
         weights = np.zeros(problem.nu)
         for i, contact in enumerate(contacts):
             if contact is Contact.BOARD:
                 weights[index[i]] = 1.0 / step**2
-        return hold_first_input(problem, self._plan.first_input, weights)
+        return hold_first_input(problem, first_input, weights)
 
     def _roll_drift(
         self, x0: Array, now: float, balancing: bool, estimate: EstimatedState
@@ -1005,10 +1122,9 @@ class MpcRider(Controller):
             if values:
                 ms = np.asarray(values)
                 out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
-        qp = self.mpc.qp
         out["mpc_solves"] = len(self._mpc_ms)
         out["speed_preview_s"] = self._speed_preview_s()
-        out["mpc_fallbacks"] = int(qp.failures) if qp is not None else 0
+        out["mpc_fallbacks"] = self._mpc_failures
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries
         out["wbc_daqp_solves"] = self.wbc.qp.fallbacks

@@ -65,6 +65,7 @@ has :math:`D` in its speed equations (:meth:`ShoeObserver.speed_drift`).
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
 from dataclasses import replace
@@ -208,6 +209,13 @@ class ShoeObserver:
             if self._load[k] > 0.0:
                 self.offsets[k] = min(max(self._moment[k] / self._load[k], -LIMIT), LIMIT)
                 self.drag[k] = self._force[k] / self._weight[k] + uphill
+
+    def frozen(self) -> ShoeObserver:
+        """A copy whose offsets and drags stay as they are now, whatever later updates
+        do to this one's (an MPC problem built beside the control loop reads them)."""
+        out = copy.copy(self)
+        out.offsets, out.drag = self.offsets.copy(), self.drag.copy()
+        return out
 
     def speed_drift(self, c: Array, dt: float, speeds: Sequence[int]) -> Array:
         """The MPC's affine terms ``c`` (N x nx) with each shoe's drag in its speed equation,

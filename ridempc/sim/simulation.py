@@ -315,6 +315,8 @@ class Simulation:
                 result.status, result.error = "failed", str(exc)
             finally:  # parameter changes last one run only
                 self.changes.restore()
+                if self.controller is not None:
+                    self.controller.close()
         result.sim_time = tick / hz
         result.wall_time = time.perf_counter() - start
         result.log = recorder.arrays()
