@@ -33,6 +33,8 @@ def test_board_variants_resolve_by_board() -> None:
     with pytest.raises(ConfigError, match="does not apply to board 'skateboard'"):
         resolve_scenario("wave", "skateboard")
     assert scenario_applies("roll-tracking", "cyberdog2", "skateboard")
+    assert scenario_applies("push-off-0.5", "go1", "skateboard")  # any quadruped
+    assert not scenario_applies("push-off-0.5", "none", "skateboard")  # a dead weight
     assert not scenario_applies("roll-tracking", "cassie", "skateboard")
     assert not scenario_applies("wave", "cassie", "segway")
 
@@ -104,12 +106,14 @@ def test_command_timeline_steps_and_ramps(tmp_path: Path) -> None:
         assert command.model_fields_set == set(Command.model_fields)
 
 
-def test_each_skateboard_library_target_has_a_push_off_scenario() -> None:
+@pytest.mark.parametrize("robot", ["cyberdog2", "go1"])
+def test_each_skateboard_library_target_has_a_push_off_scenario(robot: str) -> None:
     """``push-off-<target>`` for each committed push-off from rest (``accelerate``; a
-    ``repush`` starts rolling), judged at the end of the entry's push-off."""
+    ``repush`` starts rolling) of each quadruped's library, judged at the end of the entry's
+    push-off."""
     from ridempc.library.store import library_folder, load_library
 
-    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
+    _, entries = load_library(library_folder(robot, "skateboard"))
     for entry in (e for e in entries if e.record.kind == "accelerate"):
         scenario = resolve_scenario(f"push-off-{entry.record.target:.1f}", "skateboard")
         assert scenario.push_off is not None

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from ridempc.library.store import library_folder, load_library
+from ridempc.pair_description import load_pair_description
 from ridempc.paths import motion_library_dir
 from ridempc.trajopt.pairs import EntrySpec, load_pair, pair_names
 from ridempc.trajopt.problem import collocation_defect, solve_trajectory
@@ -34,6 +35,10 @@ REBUILD_INPUT_TOLERANCE = 1e-3
 HEIGHT_TOLERANCE = 0.03
 
 PAIRS = [name for name in pair_names() if (motion_library_dir() / name / "manifest.json").exists()]
+# The quadrupeds' libraries (a ``skate`` problem), each checked by the skateboard tests below.
+SKATE_PAIRS = [
+    name for name in PAIRS if load_pair_description(*name.split("-", 1)).trajopt.problem == "skate"
+]
 
 
 def _split(name: str) -> tuple[str, str]:
@@ -41,11 +46,17 @@ def _split(name: str) -> tuple[str, str]:
     return robot, board
 
 
-def test_the_default_quadruped_library_is_committed() -> None:
-    assert "cyberdog2-skateboard" in PAIRS
-    manifest, _ = load_library(library_folder("cyberdog2", "skateboard"))
+@pytest.mark.parametrize(
+    "pair_name",
+    [n for n in pair_names() if load_pair_description(*_split(n)).trajopt.problem == "skate"],
+)
+def test_each_quadruped_library_is_committed(pair_name: str) -> None:
+    """Every quadruped's pair file has its library, with its pair file's push-off targets."""
+    assert pair_name in SKATE_PAIRS
+    manifest, _ = load_library(library_folder(*_split(pair_name)))
     targets = {e.target for e in manifest.entries if e.kind == "accelerate"}
-    assert {0.3, 0.5, 0.7, 1.0} <= targets
+    assert set(load_pair_description(*_split(pair_name)).trajopt.default_targets) <= targets
+    assert {0.3, 0.5, 0.7, 1.0} <= targets  # the skateboard's push-off-<v> scenarios
 
 
 @pytest.mark.parametrize("pair_name", PAIRS)
@@ -103,24 +114,26 @@ def test_the_rider_keeps_its_riding_height(pair_name: str) -> None:
         assert sag < HEIGHT_TOLERANCE, f"{entry.record.name}: {sag:.3f} m off {height:.3f} m"
 
 
-def _skate_entries() -> Iterator[tuple[Any, Any, dict[Contact, np.ndarray]]]:
-    """Each committed skateboard entry with its stored options and its schedule's masks."""
-    robot, _ = skate_models("cyberdog2", "skateboard")
-    _, entries = load_library(library_folder("cyberdog2", "skateboard"))
+def _skate_entries(pair_name: str) -> Iterator[tuple[Any, Any, dict[Contact, np.ndarray]]]:
+    """Each committed entry of a skateboard pair with its stored options and its schedule's
+    masks."""
+    robot, _ = skate_models(*_split(pair_name))
+    _, entries = load_library(library_folder(*_split(pair_name)))
     for entry in entries:
         options = skate_options(entry.record.metadata["options"])
         yield entry, options, skate_schedule(robot, entry.record.target, options).contact_masks()
 
 
-def test_the_dog_keeps_its_centre_of_mass_inside_the_feet_on_the_deck() -> None:
+@pytest.mark.parametrize("pair_name", SKATE_PAIRS)
+def test_the_dog_keeps_its_centre_of_mass_inside_the_feet_on_the_deck(pair_name: str) -> None:
     """While a foot swings (lift-off and touchdown nodes included) every skateboard entry
     keeps the centre of mass at least its ``support_margin`` inside the triangle of the three
     feet on the deck, measured here from the stored states with NumPy (the NLP imposes it in
     CasADi). Before the margin the entries left it on the triangle's diagonal when the
     pushing foot landed, and riders whose trunk tipped a little early fell."""
-    robot, _ = skate_models("cyberdog2", "skateboard")
+    robot, _ = skate_models(*_split(pair_name))
     nr = 12 + robot.n_joints
-    for entry, options, masks in _skate_entries():
+    for entry, options, masks in _skate_entries(pair_name):
         assert options.support_margin >= 0.01, entry.record.name
         swinging = masks[Contact.SWING].any(axis=1)
         checked = 0
@@ -141,13 +154,14 @@ def test_the_dog_keeps_its_centre_of_mass_inside_the_feet_on_the_deck() -> None:
         assert checked > 0, entry.record.name
 
 
-def test_the_pushing_foot_lands_nearly_still() -> None:
+@pytest.mark.parametrize("pair_name", SKATE_PAIRS)
+def test_the_pushing_foot_lands_nearly_still(pair_name: str) -> None:
     """In the grid step before it lands on the ground the pushing foot of every skateboard
     entry covers at most ``touchdown_step`` along each horizontal axis (without it, the
     1.0 m/s entry's foot reached the ground at the trunk's 1.1 m/s)."""
-    robot, _ = skate_models("cyberdog2", "skateboard")
+    robot, _ = skate_models(*_split(pair_name))
     nr = 12 + robot.n_joints
-    for entry, options, masks in _skate_entries():
+    for entry, options, masks in _skate_entries(pair_name):
         pusher = robot.feet.index(options.pusher)
         ground = masks[Contact.GROUND][:, pusher] > 0
         landings = [k for k in range(1, len(ground)) if ground[k] and not ground[k - 1]]
@@ -163,13 +177,14 @@ def test_the_pushing_foot_lands_nearly_still() -> None:
             )
 
 
-def test_the_pushing_foot_lifts_unloaded() -> None:
+@pytest.mark.parametrize("pair_name", SKATE_PAIRS)
+def test_the_pushing_foot_lifts_unloaded(pair_name: str) -> None:
     """In the grid step before it lifts off the ground the pushing foot of every skateboard
     entry carries at most ``liftoff_force`` weights per foot (without it, the 1.0 m/s entry's
     last push ended at 51 N, and push-off-1.0 seed 18 fell after it)."""
-    robot, _ = skate_models("cyberdog2", "skateboard")
+    robot, _ = skate_models(*_split(pair_name))
     weight_per_foot = robot.mass * GRAVITY / robot.n_feet
-    for entry, options, masks in _skate_entries():
+    for entry, options, masks in _skate_entries(pair_name):
         pusher = robot.feet.index(options.pusher)
         ground = masks[Contact.GROUND][:, pusher] > 0
         lifts = [k for k in range(len(ground) - 1) if ground[k] and not ground[k + 1]]
@@ -182,15 +197,16 @@ def test_the_pushing_foot_lifts_unloaded() -> None:
             )
 
 
-def test_the_stance_legs_stay_under_the_motor_curves() -> None:
+@pytest.mark.parametrize("pair_name", SKATE_PAIRS)
+def test_the_stance_legs_stay_under_the_motor_curves(pair_name: str) -> None:
     """Every skateboard entry's stance-leg statics torques stay within ``torque_fraction`` of
     the motors' torque-speed curves at the entry's planned joint rates (the NLP's rows,
     measured here with NumPy): the curves hold for the committed entries."""
-    robot, _ = skate_models("cyberdog2", "skateboard")
+    robot, _ = skate_models(*_split(pair_name))
     nf, nr = robot.n_feet, 12 + robot.n_joints
     q = ca.SX.sym("q", robot.n_joints)
     jacobians = ca.Function("jacobians", [q], [robot.foot_jacobian(q, i) for i in range(nf)])
-    for entry, options, _ in _skate_entries():
+    for entry, options, _ in _skate_entries(pair_name):
         for k, u in enumerate(entry.inputs):
             x = entry.states[k]
             rotation = euler_zyx_matrix(x[3], x[4], x[5], np)

@@ -94,8 +94,8 @@ from numpy.typing import NDArray
 
 from ridempc.baselines.quadruped_legs import QuadrupedLegs
 from ridempc.baselines.quadruped_skateboard_gains import (
-    DEFAULT_GAINS_FILE,
     QuadrupedSkateboardGains,
+    gains_file,
     load_quadruped_skateboard_gains,
 )
 from ridempc.baselines.quadruped_support import SupportPlane, fit_support_plane, vertical_loads
@@ -205,7 +205,8 @@ class QuadrupedSkateboardPD(Controller):
     Args:
         robot: A quadruped with abad-hip-knee legs.
         board: ``skateboard`` (a board of kind skateboard with its reduced model) or ``none``.
-        gains: Checked gains; by default read from ``quadruped_skateboard.toml``.
+        gains: Checked gains, or their file; by default the robot's
+            (:func:`~ridempc.baselines.quadruped_skateboard_gains.gains_file`).
 
     Raises:
         ConfigError: Malformed gains, a robot whose legs are not abad-hip-knee chains, a
@@ -216,13 +217,13 @@ class QuadrupedSkateboardPD(Controller):
         self,
         robot: Robot,
         board: str = "skateboard",
-        gains: QuadrupedSkateboardGains | Path | str = DEFAULT_GAINS_FILE,
+        gains: QuadrupedSkateboardGains | Path | str | None = None,
     ) -> None:
         super().__init__(robot, board)
         self.gains = (
             gains
             if isinstance(gains, QuadrupedSkateboardGains)
-            else load_quadruped_skateboard_gains(gains)
+            else load_quadruped_skateboard_gains(gains or gains_file(robot.name))
         )
         self.rate_hz = self.gains.rate_hz
         self.roll_model = _roll_model(board)

@@ -25,10 +25,11 @@ __all__ = [
     "QuadrupedSkateboardGains",
     "RollGains",
     "SteeringGains",
+    "gains_file",
     "load_quadruped_skateboard_gains",
 ]
 
-DEFAULT_GAINS_FILE = Path(__file__).with_name("quadruped_skateboard.toml")
+DEFAULT_GAINS_FILE = Path(__file__).with_name("quadruped_skateboard.toml")  # CyberDog2's figures
 
 
 class _Frozen(CheckedModel):
@@ -162,3 +163,12 @@ def load_quadruped_skateboard_gains(
             the message names the file and the field.
     """
     return load_checked(Path(path), QuadrupedSkateboardGains, "quadruped skateboard gain file")
+
+
+def gains_file(robot: str) -> Path:
+    """The gains file of the robot named ``robot``: its own,
+    ``quadruped_skateboard.<robot>.toml`` beside the shared one, if it has one (figures that
+    depend on its mass, its stance and its feet), else the shared :data:`DEFAULT_GAINS_FILE`.
+    """
+    own = DEFAULT_GAINS_FILE.with_name(f"quadruped_skateboard.{robot}.toml")
+    return own if own.is_file() else DEFAULT_GAINS_FILE

@@ -68,6 +68,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from ridempc.robots.kind import RobotKind, robot_kind
 from ridempc.scenarios.path import PathCommand
 from ridempc.scenarios.terrain import TerrainItem, check_terrain
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX, SCALE_MAX
@@ -277,6 +278,8 @@ class Scenario(_Frozen):
     description: str = ""
     duration: RideDuration
     robots: tuple[str, ...] = ()  # robots it applies to; empty means any
+    # kinds of robot it applies to (robot.toml's `kind`: biped, quadruped); empty means any
+    robot_kinds: tuple[RobotKind, ...] = ()
     boards: tuple[str, ...] = ()  # boards it applies to; empty means any
     metrics_start: Time = 0.0  # tracking errors are measured from this time on [s]
     foot_offset: tuple[Offset, Offset] = (0.0, 0.0)  # feet off the platform centre, (x, y) [m]
@@ -325,8 +328,10 @@ class Scenario(_Frozen):
         return self
 
     def applies_to(self, robot: str, board: str) -> bool:
-        return (not self.robots or robot in self.robots) and (
-            not self.boards or board in self.boards
+        return (
+            (not self.robots or robot in self.robots)
+            and (not self.robot_kinds or robot_kind(robot) in self.robot_kinds)
+            and (not self.boards or board in self.boards)
         )
 
     def command_at(self, t: float) -> Command:
