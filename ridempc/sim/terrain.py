@@ -34,6 +34,7 @@ from ridempc.scenarios.terrain import (
     TerrainItem,
     footprint,
 )
+from ridempc.terrain_contact import TERRAIN_BITS
 
 __all__ = [
     "STEP_DOWN_RADII",
@@ -390,7 +391,7 @@ def add_terrain(spec: mujoco.MjSpec, layout: TerrainLayout, floor: str = "floor"
     """Add the terrain to a scene's spec (the floor plane moved to ``floor_z``); returns the
     names of the terrain's geoms, which touch what the floor touches."""
     spec.geom(floor).pos = [0.0, 0.0, layout.floor_z]
-    contact = {"contype": 1, "conaffinity": 3, "condim": 3, **STIFF_CONTACT}
+    contact = {**TERRAIN_BITS, "condim": 3, **STIFF_CONTACT}
     template = spec.geom(floor)
     names = []
     for i, box in enumerate(layout.boxes):
