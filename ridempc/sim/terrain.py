@@ -9,6 +9,8 @@ rolling wheel on its triangle edges. Only a rough patch is a heightfield.
 The start (the origin) stays at :math:`z = 0`: a profile going down puts the floor plane
 lower, so a ride on terrain starts exactly as one on flat ground. The controllers never see
 any of this; only the fall detector and the metrics read :meth:`TerrainLayout.height_at`.
+The terrain's geoms touch what the floor touches and a wheel's tread
+(:mod:`ridempc.terrain_contact`).
 """
 
 from __future__ import annotations
