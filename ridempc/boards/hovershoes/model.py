@@ -18,7 +18,9 @@ Per shoe ``s`` in (``left``, ``right``) the board has:
 The wheel is a flat cylinder as wide as ``wheel_width``: MuJoCo's cylinder-plane contact
 puts a contact at each rim, so the tyre carries the shoe sideways (no lateral sliding, a
 loaded shoe does not roll over on its own) and resists yaw by friction at its rims, while it
-rolls freely forward. Inertias are explicit, so MuJoCo and Pinocchio read the same masses.
+rolls freely forward. On the terrain the tyre touches as a capsule of the same radius and
+rim points, ``<s>_tread`` (:mod:`ridempc.terrain_contact`: MuJoCo's cylinder-box collider
+gets an edge wrong). Inertias are explicit, so MuJoCo and Pinocchio read the same masses.
 """
 
 from __future__ import annotations
