@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from ridempc.boards import load_board
+from ridempc.estimation import EstimatedState
 from ridempc.estimation.state import BoardEstimate
 from ridempc.mpc.rider import MpcRider
 from ridempc.mpc.slope import GRAVITY, SlopeEstimator
@@ -53,9 +54,9 @@ def test_the_library_frame_carries_the_grounds_height() -> None:
     assert frame.point_to_library(np.array([3.0, 2.0, -0.1])) == pytest.approx([1.0, 0.0, 0.0])
 
 
-def test_the_mpc_frame_follows_the_ground_under_the_platforms() -> None:
-    """Platforms 0.1 m lower than where they started: the library frame sinks with them,
-    so the rider's centre of mass keeps its height over them in the MPC's state."""
+def _standing_dog() -> tuple[MpcRider, EstimatedState]:
+    """The dog's MPC rider after a tenth of a second standing on the skateboard, and its
+    estimate."""
     dog = load_robot("cyberdog2")
     scenario = resolve_scenario("stand-still", "skateboard").with_duration(0.1)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
@@ -63,6 +64,13 @@ def test_the_mpc_frame_follows_the_ground_under_the_platforms() -> None:
     Simulation(scene, rider, scenario).run()
     estimate = rider.estimator.state
     assert estimate is not None and estimate.boards
+    return rider, estimate
+
+
+def test_the_mpc_frame_follows_the_ground_under_the_platforms() -> None:
+    """Platforms 0.1 m lower than where they started: the library frame sinks with them,
+    so the rider's centre of mass keeps its height over them in the MPC's state."""
+    rider, estimate = _standing_dog()
     n, state_map = rider.layout.names, rider.map
     state_map.reset()  # the platforms' first height: where the estimate has them now
     later = replace(estimate, time=estimate.time + 1.0)  # ten filter time constants later
@@ -78,3 +86,26 @@ def test_the_mpc_frame_follows_the_ground_under_the_platforms() -> None:
     assert state_map.follow_ground(lowered) - level == pytest.approx(-0.1, abs=1e-3)
     after = state_map.state(estimate)
     assert after[n["com_z"]] - before[n["com_z"]] == pytest.approx(0.1, abs=1e-3)
+
+
+@pytest.mark.parametrize(("feet_each", "followed"), [(None, 0.0), (1, 0.02)])
+def test_a_rise_within_the_band_is_followed_only_under_single_feet(
+    feet_each: int | None, followed: float
+) -> None:
+    """A 2 cm rise: within the band for the dog's four-footed deck (a foot off it moves its
+    estimate that much), followed at once when each platform carries one foot."""
+    rider, estimate = _standing_dog()
+    if feet_each is not None:
+        boards = tuple(replace(b, feet=b.feet[:feet_each]) for b in estimate.boards)
+        estimate = replace(estimate, boards=boards)
+    state_map = rider.map
+    state_map.reset()
+    level = state_map.follow_ground(replace(estimate, time=estimate.time + 1.0))
+    raised = replace(
+        estimate,
+        time=estimate.time + 2.0,
+        boards=tuple(
+            replace(b, position=b.position + np.array([0.0, 0.0, 0.02])) for b in estimate.boards
+        ),
+    )
+    assert state_map.follow_ground(raised) - level == pytest.approx(followed, abs=1e-3)

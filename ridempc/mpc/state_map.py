@@ -65,7 +65,9 @@ ALONG_SLACK: float = 0.1  # [m] the board's offset along the reference's line is
 GROUND_FILTER_S: float = 0.1
 # [m] a rise of the ground the frame follows: the platforms' estimated height moves by up to
 # 2.3 cm on level ground while a foot is off the deck (the dog's push-off), which is no terrain;
-# once beyond it, the whole rise is followed until it is back within half of it
+# once beyond it, the whole rise is followed until it is back within half of it. A platform
+# under one foot (a Hovershoe) has no such excursion (its foot off, it has no estimate), so
+# platforms that each carry one foot follow the whole rise at once
 GROUND_DEADBAND_M: float = 0.03
 
 
@@ -193,6 +195,7 @@ class StateMap:
         self._on_terrain = False  # the rise is beyond GROUND_DEADBAND_M (hysteresis)
         self._ground_time = 0.0
         self.ground_rate = 0.0  # [m/s] the followed ground's rise rate
+        self._stance: list[int] = []  # the most feet each platform's estimate was taken from
         self._fill = [self._filler(name) for name in self.names]
 
     def _filler(self, name: str) -> tuple[str, int | str]:
@@ -219,6 +222,7 @@ class StateMap:
         self._on_terrain = False
         self._ground_time = 0.0
         self.ground_rate = 0.0
+        self._stance = []
         self._rates = {}
         self._heading_time = 0.0
 
@@ -430,7 +434,8 @@ class StateMap:
 
         The rise is the platforms' mean estimated height (the feet's, from the IMU and the
         kinematics: no height map) over the first one seen, followed once beyond
-        ``GROUND_DEADBAND_M`` and low-passed over ``GROUND_FILTER_S``; its rate, the
+        ``GROUND_DEADBAND_M`` (at once when each platform carries one foot) and low-passed
+        over ``GROUND_FILTER_S``; its rate, the
         platforms' mean vertical velocity low-passed the same way, comes off the centre of
         mass's (:meth:`state`), so that a rider rolling down a slope is not asked to stop
         sinking with it. Without a board estimate nothing changes.
@@ -446,7 +451,11 @@ class StateMap:
         share = min(1.0, max(0.0, estimate.time - self._ground_time) / GROUND_FILTER_S)
         self._ground_time = estimate.time
         rise = deck - self._deck_start
-        if abs(rise) > GROUND_DEADBAND_M:
+        feet = [len(b.feet) for b in estimate.boards]
+        if len(feet) != len(self._stance):
+            self._stance = feet
+        self._stance = [max(a, b) for a, b in zip(self._stance, feet, strict=True)]
+        if abs(rise) > GROUND_DEADBAND_M or all(n == 1 for n in self._stance):
             self._on_terrain = True
         elif abs(rise) < 0.5 * GROUND_DEADBAND_M:
             self._on_terrain = False

@@ -9,6 +9,8 @@ rolling wheel on its triangle edges. Only a rough patch is a heightfield.
 The start (the origin) stays at :math:`z = 0`: a profile going down puts the floor plane
 lower, so a ride on terrain starts exactly as one on flat ground. The controllers never see
 any of this; only the fall detector and the metrics read :meth:`TerrainLayout.height_at`.
+The terrain's geoms touch what the floor touches and a wheel's tread
+(:mod:`ridempc.terrain_contact`).
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from ridempc.scenarios.terrain import (
     TerrainItem,
     footprint,
 )
+from ridempc.terrain_contact import TERRAIN_BITS
 
 __all__ = [
     "STEP_DOWN_RADII",
@@ -390,7 +393,7 @@ def add_terrain(spec: mujoco.MjSpec, layout: TerrainLayout, floor: str = "floor"
     """Add the terrain to a scene's spec (the floor plane moved to ``floor_z``); returns the
     names of the terrain's geoms, which touch what the floor touches."""
     spec.geom(floor).pos = [0.0, 0.0, layout.floor_z]
-    contact = {"contype": 1, "conaffinity": 3, "condim": 3, **STIFF_CONTACT}
+    contact = {**TERRAIN_BITS, "condim": 3, **STIFF_CONTACT}
     template = spec.geom(floor)
     names = []
     for i, box in enumerate(layout.boxes):

@@ -18,7 +18,9 @@ Per shoe ``s`` in (``left``, ``right``) the board has:
 The wheel is a flat cylinder as wide as ``wheel_width``: MuJoCo's cylinder-plane contact
 puts a contact at each rim, so the tyre carries the shoe sideways (no lateral sliding, a
 loaded shoe does not roll over on its own) and resists yaw by friction at its rims, while it
-rolls freely forward. Inertias are explicit, so MuJoCo and Pinocchio read the same masses.
+rolls freely forward. On the terrain the tyre touches as a capsule of the same radius and
+rim points, ``<s>_tread`` (:mod:`ridempc.terrain_contact`: MuJoCo's cylinder-box collider
+gets an edge wrong). Inertias are explicit, so MuJoCo and Pinocchio read the same masses.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ import numpy as np
 from ridempc.boards.hovershoes.parameters import HovershoesParameters
 from ridempc.boards.parameters import BoardParameters
 from ridempc.mjcf import STIFF_CONTACT, add_encoder_sensors, add_imu_sensors
+from ridempc.terrain_contact import TREAD_BITS, WHEEL_ON_FLOOR_BITS
 
 __all__ = ["SIDES", "build_hovershoes", "shoe_names"]
 
@@ -131,14 +134,15 @@ def _add_shoe(spec: mujoco.MjSpec, p: HovershoesParameters, index: int, y: float
         axis=[0.0, 1.0, 0.0],
         damping=_WHEEL_DAMPING,
     )
-    wheel.add_geom(
-        name=f"{side}_tyre",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[radius, 0.5 * p.wheel_width, 0.0],
-        quat=_Y_AXIS_QUAT,
-        rgba=_TREAD_COLOUR,
-        **_BOARD,
-    )
+    # The tyre, a cylinder on the floor plane; on the terrain a capsule with the same rim
+    # points (the tread, not drawn): MuJoCo's cylinder-box collider puts an edge's contact on
+    # the box's side face (ridempc.terrain_contact).
+    tyre = {"size": [radius, 0.5 * p.wheel_width, 0.0], "quat": _Y_AXIS_QUAT, "rgba": _TREAD_COLOUR}
+    for name, kind, bits in (
+        ("tyre", mujoco.mjtGeom.mjGEOM_CYLINDER, {**_BOARD, **WHEEL_ON_FLOOR_BITS}),
+        ("tread", mujoco.mjtGeom.mjGEOM_CAPSULE, {**_BOARD, **TREAD_BITS, "group": 3}),
+    ):
+        wheel.add_geom(name=f"{side}_{name}", type=kind, **tyre, **bits)
     wheel.add_geom(  # a hub mark, to see the wheel turn
         name=f"{side}_hub_mark",
         type=mujoco.mjtGeom.mjGEOM_BOX,
