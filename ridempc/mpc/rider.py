@@ -117,6 +117,7 @@ from ridempc.mpc.manoeuvre import (
     StateLayout,
 )
 from ridempc.mpc.pairs import check_library_names, load_mpc_pair
+from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
@@ -278,6 +279,8 @@ class MpcRider(Controller):
         self.mpc = LinearMpc.from_library(
             robot.name, board, first.library_kind, first.target, settings
         )
+        # the rider's mass and centre of mass from its stance (ridempc.mpc.payload)
+        self.payload = PayloadEstimator(robot, self.pinocchio, self.mpc.settings.dt)
         names = self.mpc.reference.input_names
         check_library_names(self.pair.description, self.mpc.reference)
         # Board inputs of the library that this rider does not realise (the pair file's
@@ -511,6 +514,8 @@ class MpcRider(Controller):
             return None, "state estimate not finite"
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
+        loads = self.estimator.contact.last_load
+        self.payload.accumulate(loads, estimate.contact, sensors.motor_torque, sensors.imu)
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
@@ -584,6 +589,7 @@ class MpcRider(Controller):
             roll = roll + self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
+        self._absorb_payload(estimate)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
         yaw_rate = estimate.yaw_rate
         if self.lean is not None:
@@ -593,6 +599,8 @@ class MpcRider(Controller):
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
         drift = self._roll_drift(x0, now, balancing, estimate)
+        payload = self.payload.estimate.drift(len(x0), names["vz"])
+        drift = payload if drift is None else drift + payload
         if self.lean is not None:
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
@@ -652,6 +660,15 @@ class MpcRider(Controller):
             future = _solver_thread().submit(self.mpc.qp.run)
             self._pending = solve._replace(future=future)
         self._mpc_main_s += time.perf_counter() - started
+
+    def _absorb_payload(self, estimate: EstimatedState) -> None:
+        """The payload estimated over the last MPC step (:mod:`~ridempc.mpc.payload`) put
+        into the base's inertia of the models the map and the whole-body QP read."""
+        payload = self.payload.update(estimate.q, self.map.com(estimate))
+        inertia = payload.base_inertia(self.payload.nominal_base)
+        self.pinocchio.model.inertias[1] = inertia
+        self.wbc.model.model.inertias[1] = inertia
+        self._diagnostics.update(payload_kg=payload.mass)
 
     def _adopt_pending(self) -> None:
         """The pending solve's plan taken up, once its tick has come (waiting for it if
