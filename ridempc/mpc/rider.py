@@ -3,7 +3,9 @@
 Every 2 ms (500 Hz) the rider
 
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
-   board from its own feet);
+   board from its own feet), and its mass and centre of mass from its stance's loads
+   (:mod:`ridempc.mpc.payload`: a payload, or a lighter rider), which the map's and the
+   whole-body QP's models carry and the MPC's vertical rate takes as a drift;
 2. every 15th tick (30 Hz), maps the estimate into the library frame
    (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto the
    reference's line: speeds and turn rates are commanded, not a path; on a board the
@@ -280,7 +282,11 @@ class MpcRider(Controller):
             robot.name, board, first.library_kind, first.target, settings
         )
         # the rider's mass and centre of mass from its stance (ridempc.mpc.payload)
-        self.payload = PayloadEstimator(robot, self.pinocchio, self.mpc.settings.dt)
+        self.payload = (
+            PayloadEstimator(robot, self.pinocchio, self.mpc.settings.dt)
+            if stages.payload is not None
+            else None
+        )
         names = self.mpc.reference.input_names
         check_library_names(self.pair.description, self.mpc.reference)
         # Board inputs of the library that this rider does not realise (the pair file's
@@ -514,8 +520,9 @@ class MpcRider(Controller):
             return None, "state estimate not finite"
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
-        loads = self.estimator.contact.last_load
-        self.payload.accumulate(loads, estimate.contact, sensors.motor_torque, sensors.imu)
+        if self.payload is not None:
+            loads = self.estimator.contact.last_load
+            self.payload.accumulate(loads, estimate.contact, sensors.motor_torque, sensors.imu)
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
@@ -584,12 +591,12 @@ class MpcRider(Controller):
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
+        self._absorb_payload(estimate, balancing)
         pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
         if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
             roll = roll + self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
-        self._absorb_payload(estimate)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
         yaw_rate = estimate.yaw_rate
         if self.lean is not None:
@@ -599,8 +606,9 @@ class MpcRider(Controller):
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
         drift = self._roll_drift(x0, now, balancing, estimate)
-        payload = self.payload.estimate.drift(len(x0), names["vz"])
-        drift = payload if drift is None else drift + payload
+        if self.payload is not None:
+            payload = self.payload.estimate.drift(len(x0), names["vz"])
+            drift = payload if drift is None else drift + payload
         if self.lean is not None:
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
@@ -661,9 +669,15 @@ class MpcRider(Controller):
             self._pending = solve._replace(future=future)
         self._mpc_main_s += time.perf_counter() - started
 
-    def _absorb_payload(self, estimate: EstimatedState) -> None:
-        """The payload estimated over the last MPC step (:mod:`~ridempc.mpc.payload`) put
-        into the base's inertia of the models the map and the whole-body QP read."""
+    def _absorb_payload(self, estimate: EstimatedState, balancing: bool) -> None:
+        """The payload estimated over the last MPC step (:mod:`~ridempc.mpc.payload`) while
+        balancing (holding or coasting; held through a manoeuvre, whose accelerations move
+        the centre of pressure off the centre of mass) put into the models the map and the
+        whole-body QP read."""
+        if self.payload is None:
+            return
+        if not balancing:
+            self.payload.reset()
         payload = self.payload.update(estimate.q, self.map.com(estimate))
         inertia = payload.base_inertia(self.payload.nominal_base)
         self.pinocchio.model.inertias[1] = inertia
