@@ -67,6 +67,17 @@ def _stance_readings(
     return loads, torque
 
 
+def _standing_imu(q: np.ndarray) -> ImuReading:
+    """The IMU of a rider at rest in the configuration ``q``: gravity's specific force."""
+    rotation = pin.XYZQUATToSE3(q[:7]).rotation
+    quaternion = pin.Quaternion(rotation)
+    return ImuReading(
+        quaternion=np.array([quaternion.w, quaternion.x, quaternion.y, quaternion.z]),
+        angular_velocity=np.zeros(3),
+        linear_acceleration=rotation.T @ np.array([0.0, 0.0, GRAVITY]),
+    )
+
+
 def test_a_known_payload_on_a_static_stance_is_recovered() -> None:
     """+30 % of Cassie's mass 5.2 cm ahead of and 3.9 cm left of her centre of mass (the
     whole moved 1.2 and 0.9 cm), standing in her keyframe."""
@@ -82,13 +93,7 @@ def test_a_known_payload_on_a_static_stance_is_recovered() -> None:
     at = com0 + np.array([0.052, 0.039, 0.0])  # the payload's place: 1.2, 0.9 cm shift
     true_com = (mass0 * com0 + extra * at) / (mass0 + extra)
     loads, torque = _stance_readings(estimator, len(robot.motors), q, mass0 + extra, true_com)
-    rotation = pin.XYZQUATToSE3(q[:7]).rotation
-    quaternion = pin.Quaternion(rotation)
-    imu = ImuReading(
-        quaternion=np.array([quaternion.w, quaternion.x, quaternion.y, quaternion.z]),
-        angular_velocity=np.zeros(3),
-        linear_acceleration=rotation.T @ np.array([0.0, 0.0, GRAVITY]),
-    )
+    imu = _standing_imu(q)
     contact = np.ones(len(loads), dtype=bool)
     estimate = PayloadEstimate(model_mass=mass0)
     for _ in range(600):  # 20 s of MPC steps: ten of the offset's time constants
@@ -110,13 +115,7 @@ def test_no_payload_reads_none() -> None:
     q = pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
     com = np.array(pin.centerOfMass(estimator.model, estimator.data, q))
     loads, torque = _stance_readings(estimator, len(robot.motors), q, estimator.mass0, com)
-    rotation = pin.XYZQUATToSE3(q[:7]).rotation
-    quaternion = pin.Quaternion(rotation)
-    imu = ImuReading(
-        quaternion=np.array([quaternion.w, quaternion.x, quaternion.y, quaternion.z]),
-        angular_velocity=np.zeros(3),
-        linear_acceleration=rotation.T @ np.array([0.0, 0.0, GRAVITY]),
-    )
+    imu = _standing_imu(q)
     for _ in range(30):
         for _ in range(TICKS):
             estimator.accumulate(loads, np.ones(len(loads), dtype=bool), torque, imu)
