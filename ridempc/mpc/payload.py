@@ -18,24 +18,33 @@ torques and the IMU):
   :math:`\\sum_s a_s f_s = g_a(q) - \\tau_a`, :math:`\\sum_s f_s = F_i`, with
   :math:`a_s = \\partial z_s / \\partial q_a` [m/rad] the site's vertical Jacobian column
   (one site: all of it there). The sites' centre of pressure
-  :math:`p = \\sum f_s p_s / \\sum f_s` and the zero-moment-point relation give the
-  horizontal centre of mass, :math:`c_{xy} = p_{xy} + h\\, f_{xy} / f_z`, with :math:`h`
-  [m] the model's centre of mass above the sites; the offset is what it differs by from the
-  model's centre of mass (the estimate already in it), integrated. Only the directions the
-  sites span are seen: along a line of sites the shift across it stays the model's;
-  :math:`c_z` is not observed (it stays the model's).
+  :math:`p = \\sum f_s p_s / \\sum f_s` stands under the centre of mass in a static
+  balance, :math:`c_{xy} = p_{xy}` (the zero-moment point's term
+  :math:`h\\, \\ddot c_{xy} / g` is left out: read from the pelvis's IMU or the estimate's
+  velocities it swung by up to 9 cm over an MPC step); the offset is what it differs by
+  from the model's centre of mass (the estimate already in it), integrated. Only the directions the
+  sites span are seen (a line of sites: only along it); :math:`c_z` is not observed.
 
-Both are averaged over an MPC step and low-passed with the time constant
-:data:`TIME_CONSTANT_S`, only while every foot is in contact and the rider is not falling
-(:math:`f_z > g/2`), held otherwise. The estimate enters the models as a change of the base
-body's inertia (:meth:`PayloadEstimate.base_inertia`): the mass :math:`\\Delta m = \\hat m -
-m_0` at the base's centre of mass and that centre moved by :math:`\\delta` so that the
-whole centre of mass moves by the estimated offset :math:`s`,
-:math:`(m_b + \\Delta m)\\, \\delta = (m_0 + \\Delta m)\\, s`; the whole-body controller's
-dynamics then carry the payload's weight and its moment, the MPC's state the shifted
-centre of mass, and the MPC's vertical rate the extra weight,
-:math:`\\dot v_z = \\sum f_z / m_0 - g - g\\, \\Delta m / m_0` (:meth:`PayloadEstimate.drift`),
-so that its forces hold :math:`m_0 + \\Delta m`.
+Both are averaged over an MPC step, only while every foot is in contact and the rider is not
+falling (:math:`f_z > g/2`), and (by the rider) only while it balances, holding or coasting:
+a manoeuvre's accelerations move the centre of pressure off the centre of mass. The mass
+ratio :math:`\\hat m / m_0` is low-passed with the time constant :data:`TIME_CONSTANT_S`,
+its excess over 1 shrunk by :data:`MASS_DEADBAND` (the load signals' calibration) and held
+within :data:`MASS_BOUND`; the offset's error, shrunk by :data:`SHIFT_DEADBAND_M`, is
+integrated with the time constant :data:`SHIFT_TIME_CONSTANT_S`. The estimate enters the
+models' body inertias (:meth:`PayloadEstimate.inertias`): a heavier rider carries
+:math:`\\Delta m = \\hat m - m_0` on its base (a payload), a lighter one is lighter
+throughout (every body scaled), and the base's centre of mass is moved by :math:`\\delta` so
+that the whole one moves by the estimated offset :math:`s`,
+:math:`m_b' \\delta = (m_0 + \\Delta m)\\, s`. The whole-body controller's dynamics then
+carry the payload's weight and its moment, the MPC's state the shifted centre of mass, and
+the MPC's vertical rate the extra weight,
+:math:`\\dot v_z = \\sum f_z / m_0 - g - g\\, \\Delta m / m_0`
+(:meth:`PayloadEstimate.drift`), so that its forces hold :math:`m_0 + \\Delta m`.
+
+The feet must be the rider's only support: where the board takes weight elsewhere (the
+Segway's knee bar, through the shins) the feet's loads do not weigh the rider and the
+estimate runs away; a pair uses it through its ``[stages.payload]``.
 """
 
 from __future__ import annotations
@@ -86,9 +95,6 @@ SHIFT_DEADBAND_M: float = 0.01
 # the sway back (the estimate swung +-7 cm across the feet); twenty times the balance's own
 # rate keeps it to the steady part.
 SHIFT_TIME_CONSTANT_S: float = 2.0
-# The base keeps at least this share of its own mass: a lighter rider's estimate is taken
-# off the base, which cannot weigh nothing.
-MIN_BASE_SHARE: float = 0.2
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
@@ -106,13 +112,24 @@ class PayloadEstimate:
     shift: Array = field(default_factory=lambda: np.zeros(3))
     model_mass: float = 1.0
 
-    def base_inertia(self, nominal: pin.Inertia) -> pin.Inertia:
-        """The base body's inertia carrying the payload (its rotational inertia the
-        nominal one about its centre of mass)."""
-        mass = max(nominal.mass + self.mass, MIN_BASE_SHARE * nominal.mass)
-        total = self.model_mass + (mass - nominal.mass)
-        lever = nominal.lever + total * self.shift / mass
-        return pin.Inertia(mass, lever, nominal.inertia)
+    def inertias(self, nominal: list[pin.Inertia]) -> list[pin.Inertia]:
+        """The model's body inertias (joint order, ``nominal[1]`` the base's) carrying the
+        estimate: a heavier rider carries :math:`\\Delta m` on the base at its centre of
+        mass (a payload); a lighter one is lighter throughout, every body scaled by
+        :math:`(m_0 + \\Delta m) / m_0` about its own centre of mass (the loads cannot tell
+        where along the legs a mass is: these are the priors); then the base's centre of
+        mass is moved by :math:`\\delta`, :math:`m_b' \\delta = (m_0 + \\Delta m)\\, s`."""
+        out = list(nominal)
+        if self.mass >= 0.0:
+            base = nominal[1]
+            out[1] = pin.Inertia(base.mass + self.mass, base.lever, base.inertia)
+        else:
+            scale = (self.model_mass + self.mass) / self.model_mass
+            out = [pin.Inertia(i.mass * scale, i.lever, i.inertia * scale) for i in nominal]
+        base = out[1]
+        lever = base.lever + (self.model_mass + self.mass) * self.shift / base.mass
+        out[1] = pin.Inertia(base.mass, lever, base.inertia)
+        return out
 
     def drift(self, nx: int, vz: int) -> Array:
         """The payload's weight as a constant term of the MPC's rates (nx): on the vertical
@@ -151,7 +168,7 @@ class PayloadEstimator:
             else:
                 v = int(max(on_chain))
                 self.ankles.append((v, motor_v.index(v)))
-        self.nominal_base = pin.Inertia(self.model.inertias[1])
+        self.nominal_inertias = [pin.Inertia(i) for i in self.model.inertias]
         self.estimate = PayloadEstimate(model_mass=self.mass0)
         self._ratio = 1.0  # [-] the low-passed measured mass over the model's
         self._sum: Array | None = None  # the readings since the last update, summed

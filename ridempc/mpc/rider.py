@@ -679,9 +679,9 @@ class MpcRider(Controller):
         if not balancing:
             self.payload.reset()
         payload = self.payload.update(estimate.q, self.map.com(estimate))
-        inertia = payload.base_inertia(self.payload.nominal_base)
-        self.pinocchio.model.inertias[1] = inertia
-        self.wbc.model.model.inertias[1] = inertia
+        for joint, inertia in enumerate(payload.inertias(self.payload.nominal_inertias)):
+            self.pinocchio.model.inertias[joint] = inertia
+            self.wbc.model.model.inertias[joint] = inertia
         self._diagnostics.update(payload_kg=payload.mass)
 
     def _adopt_pending(self) -> None:
