@@ -83,17 +83,17 @@ TIME_CONSTANT_S: float = 0.1
 # payload they read 1.04-1.10 of the rider's weight, so a mass within this fraction of the
 # model's is the model's.
 MASS_DEADBAND: float = 0.1
-# [-] a larger reading is the load signals' error, not a payload: their calibration drifts
-# with the crouch (the Segway's rider, leaning on the knee bar, read up to 1.8 with +30 %);
-# the sweeps' payloads reach 30 %.
+# [-] a larger reading is the load signals' error, not a payload: the sweeps' payloads reach
+# 30 %, and where the feet were not the rider's only support (the Segway's knee bar) the
+# reading ran to 1.8 with +30 %.
 MASS_BOUND: float = 0.4
 # [m] the centre of pressure sways with the balance (1-3 cm across the feet over an MPC step
 # on the Hovershoes without a payload, 0.5 cm behind along them): a smaller offset is the
 # model's.
 SHIFT_DEADBAND_M: float = 0.01
 # [s] the offset integrates the sway's centre of pressure: at 0.3-0.5 s the integration fed
-# the sway back (the estimate swung +-7 cm across the feet); twenty times the balance's own
-# rate keeps it to the steady part.
+# the sway back (the estimate swung +-7 cm across the feet); about seven times the balance's
+# own time (0.3 s) keeps it to the steady part.
 SHIFT_TIME_CONSTANT_S: float = 2.0
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
