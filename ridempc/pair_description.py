@@ -197,6 +197,7 @@ class Stages(_Frozen):
     swing_force_hold: SwingForceStage | None = None
     push_weights: PushWeightsStage | None = None
     settle: SettleStage | None = None
+    payload: Used | None = None
 
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
@@ -218,6 +219,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "swing_force_hold": (frozenset(), ()),
     "push_weights": (frozenset(), ()),
     "settle": (frozenset(), ()),
+    "payload": (frozenset(), ()),
 }
 
 

@@ -136,7 +136,7 @@ def test_a_bad_push_is_refused_in_one_line(tmp_path: Path, edit: str, words: str
             '[[changes]]\nparameter = "tyre_friction"\nscale = {uniform = [0.5, 0.9]}',
             "changes.tyre_friction is drawn twice",
         ),
-        ("[payload]\nfraction = {uniform = [0.0, 1.5]}", "allowed: within [0, 1]"),
+        ("[payload]\nfraction = {uniform = [0.0, 1.5]}", "allowed: within [-0.5, 1]"),
         ("[payload]\nfraction = 0.1\noffset = [0.0, 0.0, 2.0]", "within [-1, 1] m"),
         ("[noise]\nscale = {uniform = [0.0, 2.0]}", "allowed: within (0, 10]"),
         ("[start]\nfoot_offset = [0.6, 0.0]", "allowed: within [-0.5, 0.5] m"),

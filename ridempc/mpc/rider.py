@@ -3,7 +3,9 @@
 Every 2 ms (500 Hz) the rider
 
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
-   board from its own feet);
+   board from its own feet), and its mass and centre of mass from its stance's loads
+   (:mod:`ridempc.mpc.payload`: a payload, or a lighter rider), which the map's and the
+   whole-body QP's models carry and the MPC's vertical rate takes as a drift;
 2. every 15th tick (30 Hz), maps the estimate into the library frame
    (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto the
    reference's line: speeds and turn rates are commanded, not a path; on a board the
@@ -119,6 +121,7 @@ from ridempc.mpc.manoeuvre import (
     StateLayout,
 )
 from ridempc.mpc.pairs import check_library_names, load_mpc_pair
+from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
@@ -335,6 +338,12 @@ class MpcRider(Controller):
         first = self.selector.initial()
         self.mpc = LinearMpc.from_library(
             robot.name, board, first.library_kind, first.target, settings
+        )
+        # the rider's mass and centre of mass from its stance (ridempc.mpc.payload)
+        self.payload = (
+            PayloadEstimator(robot, self.pinocchio, self.mpc.settings.dt)
+            if stages.payload is not None
+            else None
         )
         names = self.mpc.reference.input_names
         check_library_names(self.pair.description, self.mpc.reference)
@@ -572,6 +581,9 @@ class MpcRider(Controller):
             return None, "state estimate not finite"
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
+        if self.payload is not None:
+            loads = self.estimator.contact.last_load
+            self.payload.accumulate(loads, estimate.contact, sensors.motor_torque, sensors.imu)
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
@@ -639,6 +651,7 @@ class MpcRider(Controller):
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
+        self._absorb_payload(estimate, balancing)
         pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
         if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
             roll = roll + self._steering_roll(command, now, speed)
@@ -653,6 +666,9 @@ class MpcRider(Controller):
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
         drift = self._roll_drift(x0, now, balancing, estimate)
+        if self.payload is not None:
+            payload = self.payload.estimate.drift(len(x0), names["vz"])
+            drift = payload if drift is None else drift + payload
         if self.lean is not None:
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
@@ -768,6 +784,21 @@ class MpcRider(Controller):
             c = inputs.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
         return self._held_forces(problem, inputs.first_input, inputs.contacts)
+
+    def _absorb_payload(self, estimate: EstimatedState, balancing: bool) -> None:
+        """The payload estimated over the last MPC step (:mod:`~ridempc.mpc.payload`) while
+        balancing (holding or coasting; held through a manoeuvre, whose accelerations move
+        the centre of pressure off the centre of mass) put into the models the map and the
+        whole-body QP read."""
+        if self.payload is None:
+            return
+        if not balancing:
+            self.payload.reset()
+        payload = self.payload.update(estimate.q, self.map.com(estimate))
+        for joint, inertia in enumerate(payload.inertias(self.payload.nominal_inertias)):
+            self.pinocchio.model.inertias[joint] = inertia
+            self.wbc.model.model.inertias[joint] = inertia
+        self._diagnostics.update(payload_kg=payload.mass)
 
     def _adopt_pending(self) -> None:
         """The pending solve's plan taken up, once its tick has come (waiting for it if

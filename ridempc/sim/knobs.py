@@ -12,7 +12,11 @@ applies and how (:data:`KNOBS`).
   the firmware runs on the new parameters (its speed estimate uses the new radius); the
   Hovershoes' deck clears its wheel by 1 mm, so their parameter model refuses a larger one;
 - ``payload`` (``body``, ``mass`` [kg], ``offset`` [m] in the body frame): a point mass on
-  a rider body (``base`` for the base), its mass, centre of mass and inertia updated;
+  a rider body (``base`` for the base), its mass, centre of mass and inertia updated; a
+  negative mass is a lighter rider: every body of the named body's subtree (``base``: the
+  whole rider) has its mass and inertia scaled by :math:`(M + m)/M`, :math:`M` the
+  subtree's mass, each centre of mass kept (the ``offset`` does not apply), and ``-m``
+  must stay below :math:`M`;
   ``base_payload`` [kg]: one at the base's centre of mass;
 - ``motor_torque_limit`` (``scale`` only): every robot motor's peak torque;
 - ``joint_damping`` [N m s/rad] (``joint``, else every robot joint): the robot joints'
@@ -173,7 +177,38 @@ def _rider_body(changes: ScheduledChanges, change: ParameterChange, name: str) -
 def _payload(changes: ScheduledChanges, change: ParameterChange) -> Action:
     assert change.mass is not None and change.body is not None
     body = _rider_body(changes, change, change.body)
+    if change.mass < 0.0:
+        return _lighter(changes, change, body)
     return _payload_action(changes, body, change.mass, np.asarray(change.offset, dtype=float))
+
+
+def _lighter(changes: ScheduledChanges, change: ParameterChange, root: int) -> Action:
+    """A negative payload: the subtree of ``root`` scaled to ``change.mass`` less."""
+    assert change.mass is not None
+    parents = changes.model.body_parentid
+    bodies = []
+    for body in range(1, changes.model.nbody):
+        up = body
+        while up not in (0, root):
+            up = int(parents[up])
+        if up == root:
+            bodies.append(body)
+    masses = changes.nominal["body_mass"][bodies]
+    subtree = float(np.sum(masses))
+    if -change.mass >= subtree:
+        raise changes.refuse(
+            change,
+            f"payload mass = {change.mass:g} kg takes off all of body '{change.body}' "
+            f"and what it carries ({subtree:.4g} kg; a negative mass must be above {-subtree:.4g})",
+        )
+    scale = (subtree + change.mass) / subtree
+    inertias = changes.nominal["body_inertia"][bodies] * scale
+
+    def act(data: mujoco.MjData) -> None:
+        changes.model.body_mass[bodies] = masses * scale
+        changes.model.body_inertia[bodies] = inertias  # the same shapes, lighter
+
+    return act
 
 
 def _base_payload(changes: ScheduledChanges, change: ParameterChange) -> Action:
@@ -364,7 +399,7 @@ KNOBS: Mapping[str, Knob] = MappingProxyType(
         ),
         "payload": _knob(
             "kg",
-            0.0,
+            -PAYLOAD_MASS_MAX,  # negative: a lighter rider, at most all of the body's subtree
             PAYLOAD_MASS_MAX,
             "a point mass on a rider body",
             _payload,

@@ -108,8 +108,9 @@ Direction = Annotated[Quantity, within(-360.0, 360.0, "deg")]
 EventTime = Annotated[Quantity, within(0.0, MAX_DURATION, "s")]
 # A push longer than 5 s is a load, not a push: the scenario's bound.
 PushDuration = Annotated[Quantity, within(0.0, 5.0, "s", low_open=True)]
-# At most the rider's own mass again: more is a second rider, not a payload.
-MassFraction = Annotated[Quantity, within(0.0, 1.0, "")]
+# At most the rider's own mass again: more is a second rider, not a payload; at least half of
+# it taken off (negative: a lighter rider, the knob's links scaled): less is another robot.
+MassFraction = Annotated[Quantity, within(-0.5, 1.0, "")]
 PayloadOffset = Annotated[Quantity, within(-PAYLOAD_OFFSET_MAX, PAYLOAD_OFFSET_MAX, "m")]
 # A foot or platform moved by more than half a metre is off any deck: the scenario's bound.
 StartOffset = Annotated[Quantity, within(-0.5, 0.5, "m")]
@@ -169,7 +170,8 @@ class Payload(_Frozen):
 
     Attributes:
         body: ``base`` or a body of the robot.
-        fraction: Its mass over the rider's [-].
+        fraction: Its mass over the rider's [-] (negative: a lighter rider, ``payload``'s
+            knob, :mod:`ridempc.sim.knobs`).
         offset: Its position in the body's frame [m].
     """
 

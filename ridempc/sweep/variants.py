@@ -221,7 +221,7 @@ def _variant_fields(
     payload = distribution.payload
     if payload is not None:
         mass = values["payload.fraction"] * rider_mass
-        if mass >= MIN_PAYLOAD_KG:
+        if abs(mass) >= MIN_PAYLOAD_KG:
             offset = tuple(values[f"payload.offset.{axis}"] for axis in "xyz")
             changes.append(
                 {"parameter": "payload", "body": payload.body, "mass": mass, "offset": offset}

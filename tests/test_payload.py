@@ -1,0 +1,151 @@
+"""The payload estimate's physics (:mod:`ridempc.mpc.payload`) and the lighter rider's knob.
+
+- A known extra mass at a known place on Cassie standing still: the loads, ankle torques and
+  IMU reading it makes are synthesised from statics (the sites' vertical forces carrying the
+  weight with their centre of pressure under the true centre of mass), fed to the estimator
+  with its estimate put back into the model each MPC step, as the rider does: the mass is
+  recovered less the dead band, and the model's centre of mass moves onto the true one.
+- A negative payload scales the rider's bodies: the robot's mass is that much less, its
+  centre of mass where it was.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from ridempc.controllers import make_controller
+from ridempc.errors import ConfigError
+from ridempc.mpc.payload import (
+    GRAVITY,
+    MASS_DEADBAND,
+    SHIFT_DEADBAND_M,
+    PayloadEstimate,
+    PayloadEstimator,
+)
+from ridempc.robots import load_robot
+from ridempc.robots.pinocchio_model import build_pinocchio_robot
+from ridempc.scenarios.scenario import ParameterChange, Scenario
+from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+from ridempc.sim.scene import build_scene
+from ridempc.sim.sensors import ImuReading
+from ridempc.sim.simulation import Simulation
+
+MPC_DT = 1.0 / 30.0  # [s] the rider's MPC step
+TICKS = 15  # control ticks per MPC step
+
+
+def _stance_readings(
+    estimator: PayloadEstimator, n_motors: int, q: np.ndarray, mass: float, com: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each foot's load fraction and the motor torques of a static stance at ``q`` carrying
+    ``mass`` [kg] with its centre of mass at ``com`` [m] (world): the sites' vertical forces
+    the least-norm ones with that sum and that centre of pressure."""
+    model, data = estimator.model, estimator.data
+    pin.computeJointJacobians(model, data, q)
+    gravity = pin.computeGeneralizedGravity(model, data, q)
+    feet = estimator.legs.feet
+    sites = [f for foot in feet for f in foot.sites]
+    points = np.array([pin.updateFramePlacement(model, data, f).translation for f in sites])
+    rows = np.vstack([np.ones(len(sites)), points[:, 0], points[:, 1]])
+    weight = mass * GRAVITY
+    forces = np.linalg.lstsq(rows, weight * np.array([1.0, com[0], com[1]]), rcond=None)[0]
+    assert np.all(forces > 0.0), "the centre of mass must stand inside the stance"
+    loads, torque, k = np.zeros(len(feet)), np.zeros(n_motors), 0
+    for i, (foot, ankle) in enumerate(zip(feet, estimator.ankles, strict=True)):
+        share = forces[k : k + len(foot.sites)]
+        loads[i] = share.sum() / estimator.share
+        if ankle is not None:
+            v, motor = ankle
+            arms = [
+                pin.getFrameJacobian(model, data, f, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[2, v]
+                for f in foot.sites
+            ]
+            torque[motor] = gravity[v] - float(np.dot(arms, share))
+        k += len(foot.sites)
+    return loads, torque
+
+
+def _standing_imu(q: np.ndarray) -> ImuReading:
+    """The IMU of a rider at rest in the configuration ``q``: gravity's specific force."""
+    rotation = pin.XYZQUATToSE3(q[:7]).rotation
+    quaternion = pin.Quaternion(rotation)
+    return ImuReading(
+        quaternion=np.array([quaternion.w, quaternion.x, quaternion.y, quaternion.z]),
+        angular_velocity=np.zeros(3),
+        linear_acceleration=rotation.T @ np.array([0.0, 0.0, GRAVITY]),
+    )
+
+
+def test_a_known_payload_on_a_static_stance_is_recovered() -> None:
+    """+30 % of Cassie's mass 5.2 cm ahead of and 3.9 cm left of her centre of mass (the
+    whole moved 1.2 and 0.9 cm), standing in her keyframe."""
+    robot = load_robot("cassie")
+    pinocchio = build_pinocchio_robot(robot)
+    estimator = PayloadEstimator(robot, pinocchio, MPC_DT)
+    q = pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
+    model = pin.Model(pinocchio.model)  # the rider's model, the estimate put into it
+    data = model.createData()
+    com0 = np.array(pin.centerOfMass(model, data, q))
+    mass0 = estimator.mass0
+    extra = 0.3 * mass0
+    at = com0 + np.array([0.052, 0.039, 0.0])  # the payload's place: 1.2, 0.9 cm shift
+    true_com = (mass0 * com0 + extra * at) / (mass0 + extra)
+    loads, torque = _stance_readings(estimator, len(robot.motors), q, mass0 + extra, true_com)
+    imu = _standing_imu(q)
+    contact = np.ones(len(loads), dtype=bool)
+    estimate = PayloadEstimate(model_mass=mass0)
+    for _ in range(600):  # 20 s of MPC steps: ten of the offset's time constants
+        for _ in range(TICKS):
+            estimator.accumulate(loads, contact, torque, imu)
+        estimate = estimator.update(q, np.array(pin.centerOfMass(model, data, q)))
+        for joint, inertia in enumerate(estimate.inertias(estimator.nominal_inertias)):
+            model.inertias[joint] = inertia
+    assert estimate.mass == pytest.approx(extra - MASS_DEADBAND * mass0, rel=1e-6)
+    com = np.array(pin.centerOfMass(model, data, q))
+    assert pin.computeTotalMass(model) == pytest.approx(mass0 + estimate.mass)
+    assert np.linalg.norm(com[:2] - true_com[:2]) <= SHIFT_DEADBAND_M + 1e-4
+
+
+def test_no_payload_reads_none() -> None:
+    """The model's own weight under its centre of mass: no mass, no offset."""
+    robot = load_robot("cassie")
+    pinocchio = build_pinocchio_robot(robot)
+    estimator = PayloadEstimator(robot, pinocchio, MPC_DT)
+    q = pinocchio.coordinates.qpos_to_pinocchio(robot.stand_qpos)
+    com = np.array(pin.centerOfMass(estimator.model, estimator.data, q))
+    loads, torque = _stance_readings(estimator, len(robot.motors), q, estimator.mass0, com)
+    imu = _standing_imu(q)
+    for _ in range(30):
+        for _ in range(TICKS):
+            estimator.accumulate(loads, np.ones(len(loads), dtype=bool), torque, imu)
+        estimate = estimator.update(q, com)
+    assert estimate.mass == 0.0
+    np.testing.assert_allclose(estimate.shift, 0.0, atol=1e-9)
+
+
+def test_a_negative_payload_is_a_lighter_rider() -> None:
+    """-30 % of Cassie's mass on the base: every body 0.7 times as heavy, the centre of mass
+    where it was."""
+    robot = load_robot("cassie")
+    scene = build_scene(robot, DEFAULT_PHYSICS_HZ, None)
+    mass = -0.3 * robot.mass
+    change = ParameterChange(parameter="payload", body="base", mass=mass)
+    scenario = Scenario(name="lighter", duration=0.01, changes=(change,))
+    sim = Simulation(scene, make_controller("stand", robot, "none"), scenario)
+    model, data = scene.model, scene.data
+    root = int(model.body_rootid[scene.base_body])
+    scene.reset()
+    mass0, com0 = float(model.body_subtreemass[root]), data.subtree_com[root].copy()
+    try:
+        sim.changes.apply(0, data)
+        assert model.body_subtreemass[root] == pytest.approx(mass0 + mass)
+        np.testing.assert_allclose(data.subtree_com[root], com0, atol=1e-12)
+    finally:
+        sim.changes.restore()
+    assert model.body_subtreemass[root] == pytest.approx(mass0)
+    with pytest.raises(ConfigError, match="takes off all of body 'base'"):
+        heavy = ParameterChange(parameter="payload", body="base", mass=-1.5 * robot.mass)
+        Simulation(scene, make_controller("stand", robot, "none"),
+                   Scenario(name="none", duration=0.01, changes=(heavy,)))  # fmt: skip
