@@ -234,6 +234,7 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
         else None,
         "collisions": len(judge.collisions),
         "collision_events": judge.collisions,
+        "boxes_straddled": sum(bool(box.contains(ridden).any()) for box in boxes),
         "perception_precision": round(scores.precision, 4),
         "perception_recall": round(scores.recall, 4),
         "perception_false_share": round(scores.false_share, 5),

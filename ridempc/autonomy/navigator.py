@@ -9,6 +9,10 @@ controller reads (:meth:`Navigator.command_at`, also its command preview), reach
 riders' acceleration limits. It sees the camera's depth images and the controller's state
 estimate, never the scene.
 
+A low obstacle narrow enough to pass between the feet (:mod:`ridempc.autonomy.straddle`)
+is not ridden round: the path runs along its axis and the feet are spread around it (the
+wave pattern's lateral offset in the command).
+
 A band that fails ``failures_to_stop`` times in a row, or a goal that becomes unreachable,
 stops the rider (it slows at ``stop_decel`` and holds); the summary records when and why.
 """
@@ -28,6 +32,14 @@ from ridempc.autonomy.depth_sensor import DepthSensor, mount_pose
 from ridempc.autonomy.dijkstra import NoPath, plan
 from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import Perception
+from ridempc.autonomy.straddle import (
+    Straddle,
+    StraddleSettings,
+    find_straddles,
+    lane_walls,
+    onto_axes,
+    straddle_lethal,
+)
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner, TebSettings
 from ridempc.controllers.base import Controller
 from ridempc.scenarios.scenario import Command
@@ -71,6 +83,7 @@ class NavigatorSettings:
         command_horizon: The command is the band's mean speed and yaw rate over its first
             this many seconds [s] (the riders lag their command by about that much).
         teb: The band's settings.
+        straddle: What is passed between the feet, and how.
     """
 
     planner_hz: float = 10.0
@@ -94,6 +107,7 @@ class NavigatorSettings:
     obstacle_radius: float = 2.5
     command_horizon: float = 0.5
     teb: TebSettings = field(default_factory=TebSettings)
+    straddle: StraddleSettings = field(default_factory=StraddleSettings)
 
 
 class Navigator:
@@ -136,6 +150,9 @@ class Navigator:
         self.costmap: Costmap | None = None
         self._command = (0.0, 0.0, 0.0)  # (time, speed, yaw rate) of the last command
         self._target = (0.0, 0.0)
+        self._spread = (0.0, 0.0, 0.0)  # (time, offset, target offset) of the feet [s, m, m]
+        self.straddles: tuple[Straddle, ...] = ()
+        self.straddle_times: list[float] = []  # update times at which the feet were spread
         self._decel = s.accel
         self._failures_in_row = 0
         self.arrived_at: float | None = None
@@ -160,7 +177,14 @@ class Navigator:
         w = w0 + float(
             np.clip(w1 - w0, -self.settings.yaw_accel * dt, self.settings.yaw_accel * dt)
         )
-        return Command.model_construct(velocity=v, yaw_rate=w)
+        t1, offset, wanted = self._spread
+        rate = self.settings.straddle.spread_rate * max(0.0, t - t1)
+        offset += float(np.clip(wanted - offset, -rate, rate))
+        return Command.model_construct(velocity=v, yaw_rate=w, lateral_offset=offset)
+
+    def _respread(self, t: float, offset: float) -> None:
+        if offset != self._spread[2]:
+            self._spread = (t, self.command_at(t).lateral_offset, offset)
 
     def _retarget(self, t: float, speed: float, yaw_rate: float) -> None:
         now = self.command_at(t)
@@ -213,6 +237,9 @@ class Navigator:
             return
         base, rotation = pose
         yaw = math.atan2(rotation[1, 0], rotation[0, 0])
+        self._respread(t, self._straddle_spread(base[:2]))
+        if self._spread[2] > 0.0:
+            self.straddle_times.append(t)
         to_goal = float(np.hypot(*(self.goal - base[:2])))
         if self.arrived_at is None and to_goal <= self.settings.arrive:
             self._command = (t, 0.0, 0.0)  # a step: the riders brake as they were built to
@@ -251,10 +278,33 @@ class Navigator:
         self._decel = self.settings.accel
         self._retarget(t, v, w)
 
+    def _straddle_spread(self, position: Array) -> float:
+        """The feet's lateral offset wanted at ``position`` [m]: spread within the lead of
+        a straddle and near its axis (wider than its lane: once lined up, spread)."""
+        st = self.settings.straddle
+        for straddle in self.straddles:
+            if straddle.in_lane(position, st.lane + straddle.half_width, st.lead):
+                return st.spread
+        return 0.0
+
+    def _obstacle_cells(self) -> NDArray[np.bool_]:
+        """The occupied cells that are obstacles: the straddles' cells are not."""
+        occupied = self.grid.occupied()
+        for straddle in self.straddles:
+            occupied &= ~straddle.cells
+        return occupied
+
     def _replan(self, start: Array, t: float) -> bool:
         s = self.settings
         began = time.perf_counter()
-        costmap = inflate(self.grid.frame, self.grid.occupied(), s.inscribed, s.decay)
+        self.straddles = find_straddles(
+            self.grid.frame, self.grid.occupied(), self.grid.height, s.straddle, start
+        )
+        costmap = inflate(self.grid.frame, self._obstacle_cells(), s.inscribed, s.decay)
+        # the global planner's cells are coarser than the lane: it gets one of them more
+        lane = s.straddle.lane + s.global_coarsening * self.grid.frame.resolution
+        lethal = straddle_lethal(self.grid.frame, self.straddles, s.inscribed, lane)
+        costmap.cost[lethal] = np.inf
         costmap.cost[~self.grid.observed] += s.unknown_cost
         costmap = costmap.coarsened(s.global_coarsening)
         self.costmap = costmap
@@ -265,8 +315,8 @@ class Navigator:
             self._stop(t, f"global planner: {exc}")
             return False
         self.global_times.append(time.perf_counter() - began)
-        self.path = path
-        self.paths.append(path)
+        self.path = onto_axes(path, self.straddles, s.inscribed, lane)
+        self.paths.append(self.path)
         return True
 
     def _local_goal(self, position: Array) -> Array:
@@ -284,9 +334,16 @@ class Navigator:
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        return nearby_cells(
-            self.grid.frame, self.grid.occupied(), position, self.settings.obstacle_radius
-        )
+        """The band's obstacle points: the occupied cells near ``position`` and, for each
+        straddle near it, the walls of its lane."""
+        s = self.settings
+        cells = nearby_cells(self.grid.frame, self._obstacle_cells(), position, s.obstacle_radius)
+        walls = [
+            lane_walls(straddle, s.teb.d_min, s.straddle.lane)
+            for straddle in self.straddles
+            if np.linalg.norm(straddle.center - position) <= s.obstacle_radius
+        ]
+        return np.vstack([cells, *walls]) if walls else cells
 
     def trace_arrays(self) -> dict[str, Array]:
         """Every band's time [s], command (speed [m/s], yaw rate [rad/s]) and local goal
@@ -317,6 +374,17 @@ class Navigator:
             "teb_updates": len(self.teb_times),
             "global_plans": len(self.global_times),
             "frames_fused": len(self.perception_times),
+            "straddles": [
+                {
+                    "center_m": [round(float(v), 3) for v in st.center],
+                    "axis": [round(float(v), 3) for v in st.axis],
+                    "width_m": round(2.0 * st.half_width, 3),
+                    "length_m": round(2.0 * st.half_length, 3),
+                    "height_m": round(st.height, 3),
+                }
+                for st in self.straddles
+            ],
+            "feet_spread_s": round(len(self.straddle_times) / self.settings.planner_hz, 2),
         }
 
 

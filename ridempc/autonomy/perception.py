@@ -78,6 +78,6 @@ class Perception:
         away = np.hypot(points[:, 0] - base[0], points[:, 1] - base[1]) > self.self_radius
         voxels = voxel_filter(points[away])
         split = segment_ground(voxels)
-        self.grid.update(position, split.ground, split.obstacles)
+        self.grid.update(position, split.ground, split.obstacles, split.obstacle_heights)
         scan = pseudo_scan(split.obstacles, base[:2], yaw, self.fov)
         return PerceivedFrame(split.ground, split.obstacles, scan, time.perf_counter() - began)
