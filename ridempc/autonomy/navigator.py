@@ -315,20 +315,24 @@ class Navigator:
             self._stop(t, f"global planner: {exc}")
             return False
         self.global_times.append(time.perf_counter() - began)
-        self.path = onto_axes(path, self.straddles, s.inscribed, lane)
+        # the local goal stays on the axis while the rider is in the lane
+        self.path = onto_axes(path, self.straddles, s.inscribed + LOOK_AHEAD, lane)
         self.paths.append(self.path)
         return True
 
     def _local_goal(self, position: Array) -> Array:
-        """The pose ``LOOK_AHEAD`` along the global path from its point nearest the rider."""
+        """The pose ``LOOK_AHEAD`` along the global path from its point nearest the rider
+        (the straddle's shorter look-ahead while the feet are spread: a lateral error is
+        closed over about that distance)."""
+        ahead = self.settings.straddle.look_ahead if self._spread[2] > 0.0 else LOOK_AHEAD
         path = self.path
         nearest = int(np.argmin(np.linalg.norm(path - position, axis=1)))
         rest = np.vstack([position, path[nearest:], self.goal])
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(rest, axis=0), axis=1))])
-        if arc[-1] <= LOOK_AHEAD:
+        if arc[-1] <= ahead:
             d = rest[-1] - rest[max(0, len(rest) - 6)]
             return np.array([*self.goal, math.atan2(d[1], d[0])])
-        k = int(np.searchsorted(arc, LOOK_AHEAD))
+        k = int(np.searchsorted(arc, ahead))
         point = rest[k]
         d = rest[min(len(rest) - 1, k + 3)] - rest[max(0, k - 3)]
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])

@@ -43,22 +43,27 @@ class StraddleSettings:
             straddle course's 0.1 m box measures 0.16 m (depth noise and the ground estimate
             under it); a box that low stays between the decks, below the feet on them and
             the legs rising from them. Taller ones are ridden round.
-        max_width: Widest obstacle straddled, across its axis [m]: at the wave's widest
-            stance the feet are 0.52 m apart, the 0.12 m decks' inner edges 0.40 m, less
-            5 cm a side for the ridden path's error.
+        max_width: Widest obstacle straddled, as measured across its axis [m]: at the
+            wave's widest stance the feet are 0.52 m apart and the shoes' inner sides about
+            0.37 m, which leaves a 0.25 m box the lane's 6 cm a side; a measured width runs
+            up to a cell of speckle wider each side (the course's 0.2 m box: 0.20-0.30 m).
         lane: Half-width of the lane about the axis the rider's centre keeps to [m].
         lead: Distance before (and after) the obstacle over which the feet are spread [m]:
             the spread's slew needs 0.5 s, 0.25 m at 0.5 m/s, and the band lines up first.
         spread: Each foot's lateral offset while straddling [m] (the wave scenario's 0.05).
         spread_rate: Slew of that offset [m/s] (the wave's 0.08 m/s peak, at 0.05 m / 4 s).
+        look_ahead: The local goal's distance along the path while straddling [m]: the
+            rider closes a lateral error over about this distance, and 1.75 m (the
+            paper's) let the MPC rider drift 7 cm off the axis over the 0.6 m box.
     """
 
     max_height: float = 0.2
-    max_width: float = 0.30
+    max_width: float = 0.35
     lane: float = 0.06
     lead: float = 0.8
     spread: float = 0.05
     spread_rate: float = 0.1
+    look_ahead: float = 0.8
 
 
 @dataclass(frozen=True)

@@ -91,6 +91,7 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.input_rate import hold_first_input
@@ -563,7 +564,8 @@ class MpcRider(Controller):
             self._diagnostics["lean_offset"] = self.lean.offset
         if self.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
-            states = steer_onto_lines(problem.state_reference, problem.initial_state, columns)
+            states = spread_lines(problem.state_reference, columns, command.lateral_offset)
+            states = steer_onto_lines(states, problem.initial_state, columns)
             states = self.shoes.shift_reference(states, columns)
             c = self.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
             problem = replace(problem, state_reference=states, c=c)
