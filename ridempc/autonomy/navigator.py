@@ -27,24 +27,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.autonomy.camera import CameraIntrinsics
-from ridempc.autonomy.costmap import Costmap, inflate
+from ridempc.autonomy.costmap import Costmap
 from ridempc.autonomy.depth_sensor import DepthSensor, mount_pose
-from ridempc.autonomy.dijkstra import NoPath, plan
+from ridempc.autonomy.dijkstra import NoPath
+from ridempc.autonomy.global_plan import plan_global
 from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import Perception
 from ridempc.autonomy.straddle import (
     Straddle,
     StraddleSettings,
-    find_straddles,
     lane_walls,
-    onto_axes,
-    straddle_lethal,
 )
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner, TebSettings
 from ridempc.controllers.base import Controller
 from ridempc.scenarios.scenario import Command
 
-__all__ = ["Navigator", "NavigatorSettings", "nearby_cells"]
+__all__ = ["Navigator", "NavigatorSettings", "nearby_cells", "nearby_obstacles"]
 
 Array = NDArray[np.float64]
 
@@ -287,36 +285,26 @@ class Navigator:
                 return st.spread
         return 0.0
 
-    def _obstacle_cells(self) -> NDArray[np.bool_]:
-        """The occupied cells that are obstacles: the straddles' cells are not."""
-        occupied = self.grid.occupied()
-        for straddle in self.straddles:
-            occupied &= ~straddle.cells
-        return occupied
-
     def _replan(self, start: Array, t: float) -> bool:
-        s = self.settings
         began = time.perf_counter()
-        self.straddles = find_straddles(
-            self.grid.frame, self.grid.occupied(), self.grid.height, s.straddle, start
-        )
-        costmap = inflate(self.grid.frame, self._obstacle_cells(), s.inscribed, s.decay)
-        # the global planner's cells are coarser than the lane: it gets one of them more
-        lane = s.straddle.lane + s.global_coarsening * self.grid.frame.resolution
-        lethal = straddle_lethal(self.grid.frame, self.straddles, s.inscribed, lane)
-        costmap.cost[lethal] = np.inf
-        costmap.cost[~self.grid.observed] += s.unknown_cost
-        costmap = costmap.coarsened(s.global_coarsening)
-        self.costmap = costmap
+        grid = self.grid
         try:
-            path = plan(costmap, _free_start(costmap, start), self.goal)
+            planned = plan_global(
+                grid.frame,
+                grid.occupied(),
+                grid.height,
+                grid.observed,
+                start,
+                self.goal,
+                self.settings,
+            )
         except NoPath as exc:
             self.global_times.append(time.perf_counter() - began)
             self._stop(t, f"global planner: {exc}")
             return False
         self.global_times.append(time.perf_counter() - began)
-        # the local goal stays on the axis while the rider is in the lane
-        self.path = onto_axes(path, self.straddles, s.inscribed + LOOK_AHEAD, lane)
+        self.costmap, self.straddles = planned.costmap, planned.straddles
+        self.path = planned.path
         self.paths.append(self.path)
         return True
 
@@ -338,16 +326,10 @@ class Navigator:
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        """The band's obstacle points: the occupied cells near ``position`` and, for each
-        straddle near it, the walls of its lane."""
-        s = self.settings
-        cells = nearby_cells(self.grid.frame, self._obstacle_cells(), position, s.obstacle_radius)
-        walls = [
-            lane_walls(straddle, s.teb.d_min, s.straddle.lane)
-            for straddle in self.straddles
-            if np.linalg.norm(straddle.center - position) <= s.obstacle_radius
-        ]
-        return np.vstack([cells, *walls]) if walls else cells
+        obstacles = self.grid.occupied()
+        for straddle in self.straddles:
+            obstacles &= ~straddle.cells
+        return nearby_obstacles(self.grid.frame, obstacles, self.straddles, position, self.settings)
 
     def trace_arrays(self) -> dict[str, Array]:
         """Every band's time [s], command (speed [m/s], yaw rate [rad/s]) and local goal
@@ -392,6 +374,25 @@ class Navigator:
         }
 
 
+def nearby_obstacles(
+    frame: GridFrame,
+    obstacles: NDArray[np.bool_],
+    straddles: tuple[Straddle, ...],
+    position: Array,
+    settings: NavigatorSettings,
+) -> Array:
+    """The band's obstacle points: the obstacle cells within ``obstacle_radius`` of
+    ``position`` and, for each straddle that near, the walls of its lane."""
+    s = settings
+    cells = nearby_cells(frame, obstacles, position, s.obstacle_radius)
+    walls = [
+        lane_walls(straddle, s.teb.d_min, s.straddle.lane)
+        for straddle in straddles
+        if np.linalg.norm(straddle.center - position) <= s.obstacle_radius
+    ]
+    return np.vstack([cells, *walls]) if walls else cells
+
+
 def nearby_cells(
     frame: GridFrame, occupied: NDArray[np.bool_], position: Array, radius: float
 ) -> Array:
@@ -404,21 +405,6 @@ def nearby_cells(
         ]
     )
     return xy[np.linalg.norm(xy - position, axis=1) <= radius]
-
-
-def _free_start(costmap: Costmap, start: Array) -> Array:
-    """The start, or the nearest cell outside the inscribed radius when the rider stands
-    within it (a noisy map next to a box): the rider gets out the cheapest way."""
-    if not costmap.lethal_at(start):
-        return start
-    x, y = costmap.frame.centers()
-    free = np.isfinite(costmap.cost)
-    if not free.any():
-        return start
-    d = np.hypot(x - start[0], y - start[1])
-    d[~free] = np.inf
-    k = np.unravel_index(int(np.argmin(d)), d.shape)
-    return np.array([x[k], y[k]])
 
 
 def _stats(seconds: list[float]) -> dict[str, float | None]:
