@@ -59,6 +59,35 @@ def test_a_goal_inside_a_box_is_bad_input(tmp_path: Path, capsys: pytest.Capture
     assert len(err) == 1 and "inside obstacles.0" in err[0]
 
 
+SLOPE = """
+[[terrain]]
+kind = "slope"
+start = {start}
+length = 2.0
+angle = 7.0
+direction = "up"
+"""
+
+
+def test_a_course_carries_terrain(tmp_path: Path) -> None:
+    course = tmp_path / "slope.toml"
+    course.write_text(ENCLOSED.format(boxes="") + SLOPE.format(start=1.5))
+    loaded = resolve_course(str(course))
+    assert loaded.terrain[0].kind == "slope"
+    assert loaded.in_start_frame().terrain == loaded.terrain
+
+
+def test_terrain_under_the_start_is_bad_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    course = tmp_path / "slope.toml"
+    course.write_text(ENCLOSED.format(boxes="") + SLOPE.format(start=0.2))
+    assert main(["navigate", "--course", str(course), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "terrain.0.slope.start" in err[0] and "0.2" in err[0]
+    assert not (tmp_path / "o").exists()
+
+
 def test_sourced_scenario_asks_its_source() -> None:
     scenario = SourcedScenario(name="x", duration=5.0).with_source(
         lambda t: Command(velocity=0.1 * t)

@@ -98,6 +98,22 @@ def test_occupancy_precision_and_recall_within_3m(slope_deg: float) -> None:
     assert scores.false_share < 0.01
 
 
+# the terrain issue's steps, from the Hovershoes library: 1.71 wheel radii (0.076 m), and the
+# stairs' 0.79 and 0.93 (0.035, 0.041 m); down as ridden, and up
+@pytest.mark.parametrize("rise", [-0.076, -0.041, -0.035, 0.035, 0.041, 0.076])
+def test_a_rideable_step_leaves_under_1_percent_false_cells(rise: float) -> None:
+    grid = OccupancyGrid(GridFrame((-1.0, -3.0), 0.05, (140, 120)))
+    poses = [(0.3 * k, 0.0, 0.1 * (-1) ** k) for k in range(6)]  # up to 0.5 m short of it
+    for k, (x, y, yaw) in enumerate(poses):
+        position = np.array([x, y, HEIGHT])
+        depth, rays, rotation = render(position, yaw, SPEC, step=(2.0, rise))
+        split = segment_ground(voxel_filter(to_points(_noisy(depth, k), rays, rotation, position)))
+        grid.update(position, split.ground, split.obstacles)
+    path = np.array([[x, y] for x, y, _ in poses])
+    scores = score_cells(grid.frame, grid.occupied(), grid.observed, [], path, radius=3.0)
+    assert scores.false_share < 0.01
+
+
 def test_free_rays_clear_a_stale_obstacle() -> None:
     grid = _map(0.0, [], [(0.0, 0.0, 0.0)])
     cell = grid.frame.cells(np.array([[2.0, 0.0]]))[0][0]
