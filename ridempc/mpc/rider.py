@@ -508,10 +508,10 @@ class MpcRider(Controller):
             )
             self.manoeuvre = replace(wanted, start=start)
             switched = wanted.kind == REPUSH  # from wherever the coast left the rider
-            # a re-push starts mid-turn: the reference's heading already carries the turn
+            # any switch starts mid-turn: the reference's heading already carries the turn
             # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
-            # turn back at once and fell in the push)
-            self._anchor(estimate, now, self._turned if switched else 0.0)
+            # turn back at once and fell in the push; one 0.67 rad into a course, in a stop)
+            self._anchor(estimate, now, self._turned)
             self._blend = None
         else:
             switched = False
