@@ -57,6 +57,12 @@ def test_an_occupied_cell_of_unknown_height_is_not_straddled() -> None:
     assert find_straddles(FRAME, occupied, np.full(FRAME.shape, -np.inf), SETTINGS, RIDER) == ()
 
 
+def test_a_speckle_of_low_cells_is_no_straddle() -> None:
+    occupied, height = _grid([Box(center=(3.01, 0.01), size=(0.04, 0.04, 0.1))], 0.1)
+    assert 0 < occupied.sum() < SETTINGS.min_cells
+    assert find_straddles(FRAME, occupied, height, SETTINGS, RIDER) == ()
+
+
 def test_a_box_seen_by_its_front_face_is_ridden_along_the_approach() -> None:
     face = Box(center=(3.0, 0.0), size=(0.05, 0.25, 0.1))  # narrow both ways
     (straddle,) = find_straddles(FRAME, *_grid([face], 0.12), SETTINGS, RIDER)

@@ -52,6 +52,9 @@ class StraddleSettings:
             the spread's slew needs 0.5 s, 0.25 m at 0.5 m/s, and the band lines up first.
         spread: Each foot's lateral offset while straddling [m] (the wave scenario's 0.05).
         spread_rate: Slew of that offset [m/s] (the wave's 0.08 m/s peak, at 0.05 m / 4 s).
+        min_cells: Fewest cells of a straddle: a smaller group is more likely speckle
+            than a box (a 0.1 m box fills four), and stays an obstacle to ride round, not a
+            lane that would draw the path onto its axis.
         look_ahead: The local goal's distance along the path while straddling [m]: the
             rider closes a lateral error over about this distance, and 1.75 m (the
             paper's) let the MPC rider drift 7 cm off the axis over the 0.6 m box.
@@ -64,6 +67,7 @@ class StraddleSettings:
     spread: float = 0.05
     spread_rate: float = 0.1
     look_ahead: float = 0.8
+    min_cells: int = 4
 
 
 @dataclass(frozen=True)
@@ -126,9 +130,11 @@ def find_straddles(
     measured = np.where(np.isfinite(height), height, np.inf)  # none seen: not known low
     tallest = np.zeros(count + 1)
     np.maximum.at(tallest, labels[occupied], measured[occupied])
+    sizes = np.bincount(labels[occupied], minlength=count + 1)
     found = []
     r = frame.resolution
-    for k in np.nonzero(tallest[1:] <= settings.max_height)[0] + 1:
+    low = (tallest <= settings.max_height) & (sizes >= settings.min_cells)
+    for k in np.nonzero(low[1:])[0] + 1:
         i, j = np.nonzero(labels == k)
         xy = np.column_stack([frame.origin[0] + (i + 0.5) * r, frame.origin[1] + (j + 0.5) * r])
         center = xy.mean(axis=0)
