@@ -49,7 +49,9 @@ class StraddleSettings:
             up to a cell of speckle wider each side (the course's 0.2 m box: 0.20-0.30 m).
         lane: Half-width of the lane about the axis the rider's centre keeps to [m].
         lead: Distance before (and after) the obstacle over which the feet are spread [m]:
-            the spread's slew needs 0.5 s, 0.25 m at 0.5 m/s, and the band lines up first.
+            the spread's slew needs 0.5 s, 0.25 m at 0.5 m/s; the MPC rider's spread moves
+            mostly its left platform (its library frame follows that one) and the rider
+            drifts 5-7 cm with it, which the band corrects over about the look-ahead.
         spread: Each foot's lateral offset while straddling [m] (the wave scenario's 0.05).
         spread_rate: Slew of that offset [m/s] (the wave's 0.08 m/s peak, at 0.05 m / 4 s).
         min_cells: Fewest cells of a straddle: a smaller group is more likely speckle
@@ -63,7 +65,7 @@ class StraddleSettings:
     max_height: float = 0.2
     max_width: float = 0.35
     lane: float = 0.06
-    lead: float = 0.8
+    lead: float = 1.2
     spread: float = 0.05
     spread_rate: float = 0.1
     look_ahead: float = 0.8
@@ -149,8 +151,10 @@ def find_straddles(
             along, across = (xy - center) @ axis, (xy - center) @ normal
             # a cell's own extent along either direction
             pad = 0.5 * r * (abs(axis[0]) + abs(axis[1]))
-            half_width = 0.5 * float(across.max() - across.min()) + pad
-            half_length = 0.5 * float(along.max() - along.min()) + pad
+            # extents between the 5th and 95th percentiles: a stray cell at a side (one
+            # made a box 0.35 m wide for a moment, and the path went round) does not count
+            half_width = 0.5 * float(np.subtract(*np.percentile(across, [95, 5]))) + pad
+            half_length = 0.5 * float(np.subtract(*np.percentile(along, [95, 5]))) + pad
             alignment = abs(float(axis @ approach))
             if 2.0 * half_width <= settings.max_width and (best is None or alignment > best[0]):
                 best = (alignment, axis, half_length, half_width)
