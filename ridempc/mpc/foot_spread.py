@@ -10,6 +10,11 @@ the normal to its reference heading, away from the platforms' mean:
     \\bar p^*)) \\, n_i, \\qquad n_i = (-\\sin\\psi_i^*, \\cos\\psi_i^*)
 
 and the guidance law (:mod:`ridempc.mpc.guidance`) steers each platform onto its moved line.
+The rider also moves the reference it lays the library frame by: that frame follows
+platform 0 sideways onto its reference line, and onto the unspread line it followed the
+platform out and out (the rider drifted 7-10 cm over 2 s, to the side of platform 0). So the
+spread is carried by the platforms other than the one the frame follows, and the rider's
+centre moves by the offset towards them.
 """
 
 from __future__ import annotations

@@ -526,6 +526,8 @@ class MpcRider(Controller):
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
+        if self.shoes is not None:  # the frame follows platform 0 onto its spread line
+            here = spread_lines(here[None, :], self._shoe_columns, command.lateral_offset)[0]
         yaw_rate = estimate.yaw_rate
         if self.lean is not None:
             self.lean.update(now, command.yaw_rate, yaw_rate, speed)
