@@ -8,8 +8,8 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from autonomy_fakes import BlindSensor, KinematicRider
 
-from ridempc.autonomy.camera import CameraIntrinsics, DepthCameraSpec, pixel_rays
 from ridempc.autonomy.command_source import SourcedScenario
 from ridempc.autonomy.course import course_names, resolve_course
 from ridempc.autonomy.navigate import check_reachable
@@ -59,23 +59,40 @@ def test_a_goal_inside_a_box_is_bad_input(tmp_path: Path, capsys: pytest.Capture
     assert len(err) == 1 and "inside obstacles.0" in err[0]
 
 
+SLOPE = """
+[[terrain]]
+kind = "slope"
+start = {start}
+length = 2.0
+angle = 7.0
+direction = "up"
+"""
+
+
+def test_a_course_carries_terrain(tmp_path: Path) -> None:
+    course = tmp_path / "slope.toml"
+    course.write_text(ENCLOSED.format(boxes="") + SLOPE.format(start=1.5))
+    loaded = resolve_course(str(course))
+    assert loaded.terrain[0].kind == "slope"
+    assert loaded.in_start_frame().terrain == loaded.terrain
+
+
+def test_terrain_under_the_start_is_bad_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    course = tmp_path / "slope.toml"
+    course.write_text(ENCLOSED.format(boxes="") + SLOPE.format(start=0.2))
+    assert main(["navigate", "--course", str(course), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "terrain.0.slope.start" in err[0] and "0.2" in err[0]
+    assert not (tmp_path / "o").exists()
+
+
 def test_sourced_scenario_asks_its_source() -> None:
     scenario = SourcedScenario(name="x", duration=5.0).with_source(
         lambda t: Command(velocity=0.1 * t)
     )
     assert scenario.with_duration(3.0).command_at(2.0).velocity == pytest.approx(0.2)
-
-
-class _Sensor:
-    def __init__(self) -> None:
-        self.spec = DepthCameraSpec()
-        self.rays = pixel_rays(CameraIntrinsics.of(self.spec))
-
-    def capture(self, t: float, data: object) -> None:
-        pass
-
-    def delivered(self, t: float) -> None:
-        return None
 
 
 class _Controller:
@@ -90,7 +107,7 @@ class _Controller:
 
 def _navigator() -> Navigator:
     grid = OccupancyGrid(GridFrame((-2.0, -2.0), 0.05, (160, 80)))
-    return Navigator(np.array([5.0, 0.0]), grid, _Sensor(), _Controller(), HZ)  # type: ignore[arg-type]
+    return Navigator(np.array([5.0, 0.0]), grid, BlindSensor(), _Controller(), HZ)  # type: ignore[arg-type]
 
 
 def _ride(navigator: Navigator, until: float) -> list[Command]:
@@ -139,28 +156,6 @@ def _ride_on(navigator: Navigator, start: float, until: float) -> list[Command]:
     return commands
 
 
-class _KinematicRider:
-    """A unicycle whose speed and yaw rate follow the command with a 0.3 s lag."""
-
-    def __init__(self) -> None:
-        self.pose = np.zeros(3)
-        self.speed = 0.0
-        self.turn = 0.0
-
-    def estimate(self) -> SimpleNamespace:
-        yaw = self.pose[2]
-        return SimpleNamespace(
-            base_position=np.array([self.pose[0], self.pose[1], 1.0]),
-            base_quaternion=np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]),
-        )
-
-    def step(self, command: Command, dt: float) -> None:
-        self.speed += (command.velocity - self.speed) * dt / 0.3
-        self.turn += (command.yaw_rate - self.turn) * dt / 0.3
-        c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
-        self.pose += dt * np.array([self.speed * c, self.speed * s, self.turn])
-
-
 def test_a_kinematic_rider_reaches_the_corridors_goal_clear_of_its_boxes() -> None:
     from ridempc.autonomy.evaluation import rasterise
     from ridempc.autonomy.navigate import map_frame
@@ -169,9 +164,9 @@ def test_a_kinematic_rider_reaches_the_corridors_goal_clear_of_its_boxes() -> No
     frame = map_frame(course)
     grid = OccupancyGrid(frame)
     grid.log_odds[rasterise(frame, course.obstacles)] = 3.0  # the map the camera would build
-    rider = _KinematicRider()
+    rider = KinematicRider()
     hz = 300
-    navigator = Navigator(np.asarray(course.goal), grid, _Sensor(), rider, hz)  # type: ignore[arg-type]
+    navigator = Navigator(np.asarray(course.goal), grid, BlindSensor(), rider, hz)  # type: ignore[arg-type]
     clearance = math.inf
     for tick in range(round(course.duration * hz)):
         t = tick / hz

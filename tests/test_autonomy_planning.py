@@ -111,3 +111,14 @@ def test_teb_reports_a_failure_rather_than_raising() -> None:
         np.array([0.0, 0.0, 0.0]), np.array([np.nan, 0.0, 0.0]), np.zeros((0, 2))
     )
     assert not band.success
+
+
+@pytest.mark.parametrize("factor", [2, 3])
+def test_a_coarsened_costmap_keeps_each_blocks_worst_cell(factor: int) -> None:
+    costmap = inflate(FRAME, _walls((0.2, 1.2)), inscribed=0.35, decay=3.0)
+    coarse = costmap.coarsened(factor)
+    nx, ny = coarse.cost.shape
+    blocks = (nx, factor, ny, factor)
+    cost = costmap.cost[: nx * factor, : ny * factor].reshape(blocks).max(axis=(1, 3))
+    distance = costmap.distance[: nx * factor, : ny * factor].reshape(blocks).min(axis=(1, 3))
+    assert np.array_equal(coarse.cost, cost) and np.array_equal(coarse.distance, distance)

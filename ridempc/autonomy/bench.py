@@ -1,8 +1,9 @@
 """``ridempc navigate --bench``: the planners' update times on the library's courses.
 
 For each course, on the map rasterised from its boxes (what the camera builds, without its
-noise): the global plan (Dijkstra over the inflated costmap, SciPy's compiled search and
-the pure-Python :mod:`heapq` reference), repeated; and the timed elastic band at every
+noise, each cell with its box's height): the global replan as the navigator runs it
+(:func:`~ridempc.autonomy.global_plan.plan_global`: costmap, straddles, Dijkstra), repeated,
+and the search alone on the pure-Python :mod:`heapq` reference; and the timed elastic band at every
 ``STEP`` along the global path, warm-started from the last update as in a ride. Wall-clock
 figures depend on the machine's load: compare them on an idle machine.
 """
@@ -18,10 +19,11 @@ import numpy as np
 
 from ridempc.autonomy.costmap import inflate
 from ridempc.autonomy.course import course_names, resolve_course
-from ridempc.autonomy.dijkstra import plan, plan_heapq
+from ridempc.autonomy.dijkstra import plan_heapq
 from ridempc.autonomy.evaluation import rasterise
+from ridempc.autonomy.global_plan import plan_global
 from ridempc.autonomy.navigate import map_frame
-from ridempc.autonomy.navigator import NavigatorSettings, nearby_cells
+from ridempc.autonomy.navigator import NavigatorSettings, nearby_obstacles
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner
 from ridempc.io import atomic_write_json
 
@@ -47,14 +49,21 @@ def bench_course(name: str) -> dict[str, Any]:
     course = resolve_course(name).in_start_frame()
     frame = map_frame(course)
     occupied = rasterise(frame, course.obstacles)
+    height = np.full(frame.shape, -np.inf)
+    for box in course.obstacles:
+        height[rasterise(frame, [box])] = box.size[2]
+    observed = np.ones(frame.shape, dtype=bool)
     start, goal = np.asarray(course.start[:2]), np.asarray(course.goal)
     plans, heapq_plans = [], []
     path = np.zeros((0, 2))
     for _ in range(REPEATS):
         began = time.perf_counter()
-        costmap = inflate(frame, occupied, settings.inscribed, settings.decay)
-        path = plan(costmap.coarsened(settings.global_coarsening), start, goal)
+        planned = plan_global(frame, occupied, height, observed, start, goal, settings)
         plans.append(time.perf_counter() - began)
+    path, straddles = planned.path, planned.straddles
+    obstacles = occupied.copy()
+    for straddle in straddles:
+        obstacles &= ~straddle.cells
     for _ in range(HEAPQ_REPEATS):
         began = time.perf_counter()
         costmap = inflate(frame, occupied, settings.inscribed, settings.decay)
@@ -70,7 +79,7 @@ def bench_course(name: str) -> dict[str, Any]:
         band = teb.solve(
             np.array([*here, heading]),
             np.array([*ahead, _heading(path, arc, min(arc[-1], s + LOOK_AHEAD))]),
-            nearby_cells(frame, occupied, here, settings.obstacle_radius),
+            nearby_obstacles(frame, obstacles, straddles, here, settings),
             speed=settings.teb.v_max,
         )
         teb_times.append(band.solve_time)
@@ -83,6 +92,7 @@ def bench_course(name: str) -> dict[str, Any]:
         "teb_ms": _ms(teb_times),
         "teb_updates": len(teb_times),
         "teb_failures": failures,
+        "straddles": len(straddles),
     }
 
 

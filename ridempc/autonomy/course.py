@@ -14,8 +14,16 @@ Example::
     size = [0.4, 0.4, 0.5]        # full lengths x, y and the height [m]
     yaw = 0.0                     # [rad]
 
-The scene is built with the rider at its start pose; :meth:`Course.in_start_frame` gives the
-course in that frame (the rider's starting base at the origin, heading along x).
+    [[terrain]]                   # as in scenarios (ridempc.scenarios.terrain), in the
+    kind = "slope"                # start's frame: x along the start heading
+    start = 1.5
+    length = 2.0
+    angle = 7.0
+    direction = "up"
+
+A box stands on the ground's level under its centre. The scene is built with the rider at
+its start pose; :meth:`Course.in_start_frame` gives the course in that frame (the rider's
+starting base at the origin, heading along x).
 """
 
 from __future__ import annotations
@@ -29,6 +37,7 @@ from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
 from ridempc.errors import UnknownNameError
+from ridempc.scenarios.terrain import TerrainItem, check_terrain
 from ridempc.tomlfile import load_checked
 from ridempc.units import CheckedModel, Real, RideDuration
 
@@ -88,6 +97,12 @@ class Course(CheckedModel):
     robots: tuple[str, ...] = ()  # robots it applies to; empty means any
     boards: tuple[str, ...] = ()  # boards it applies to; empty means any
     obstacles: tuple[Box, ...] = ()
+    terrain: tuple[TerrainItem, ...] = ()  # in the start's frame; see ridempc.scenarios.terrain
+
+    @model_validator(mode="after")
+    def _terrain_fits(self) -> Course:
+        check_terrain(self.terrain)
+        return self
 
     @model_validator(mode="after")
     def _clear_ends(self) -> Course:

@@ -39,6 +39,7 @@ from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
+from ridempc.sim.terrain import lay_out
 
 __all__ = ["NavigateRequest", "map_frame", "navigate"]
 
@@ -151,9 +152,16 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
         add_obstacles(spec, local.obstacles)
         add_depth_camera(spec, robot.params.base_body, camera)
 
-    scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board, edit_spec=edit)
+    terrain = None
+    if local.terrain:
+        radius = getattr(board.params, "wheel_radius", None) if board is not None else None
+        try:
+            terrain = lay_out(local.terrain, radius, board_name)
+        except ConfigError as exc:
+            raise ConfigError(f"{where}: {exc}") from exc
+    scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board, edit_spec=edit, terrain=terrain)
     origin = scene.data.xpos[scene.base_body, :2].copy()  # the course's start, in the scene
-    place_obstacles(scene.model, origin)
+    place_obstacles(scene.model, origin, terrain.level_at if terrain is not None else None)
     scene.reset()
     boxes = tuple(
         b.moved((b.center[0] + origin[0], b.center[1] + origin[1]), b.yaw) for b in local.obstacles
@@ -234,6 +242,7 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
         else None,
         "collisions": len(judge.collisions),
         "collision_events": judge.collisions,
+        "boxes_straddled": sum(bool(box.contains(ridden).any()) for box in boxes),
         "perception_precision": round(scores.precision, 4),
         "perception_recall": round(scores.recall, 4),
         "perception_false_share": round(scores.false_share, 5),

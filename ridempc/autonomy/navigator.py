@@ -9,6 +9,10 @@ controller reads (:meth:`Navigator.command_at`, also its command preview), reach
 riders' acceleration limits. It sees the camera's depth images and the controller's state
 estimate, never the scene.
 
+A low obstacle narrow enough to pass between the feet (:mod:`ridempc.autonomy.straddle`)
+is not ridden round: the path runs along its axis and the feet are spread around it (the
+wave pattern's lateral offset in the command).
+
 A band that fails ``failures_to_stop`` times in a row, or a goal that becomes unreachable,
 stops the rider (it slows at ``stop_decel`` and holds); the summary records when and why.
 """
@@ -23,16 +27,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.autonomy.camera import CameraIntrinsics
-from ridempc.autonomy.costmap import Costmap, inflate
+from ridempc.autonomy.costmap import Costmap
 from ridempc.autonomy.depth_sensor import DepthSensor, mount_pose
-from ridempc.autonomy.dijkstra import NoPath, plan
+from ridempc.autonomy.dijkstra import NoPath
+from ridempc.autonomy.global_plan import plan_global
 from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import Perception
+from ridempc.autonomy.straddle import (
+    Straddle,
+    StraddleSettings,
+    lane_walls,
+)
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner, TebSettings
 from ridempc.controllers.base import Controller
 from ridempc.scenarios.scenario import Command
 
-__all__ = ["Navigator", "NavigatorSettings", "nearby_cells"]
+__all__ = ["Navigator", "NavigatorSettings", "nearby_cells", "nearby_obstacles"]
 
 Array = NDArray[np.float64]
 
@@ -71,6 +81,7 @@ class NavigatorSettings:
         command_horizon: The command is the band's mean speed and yaw rate over its first
             this many seconds [s] (the riders lag their command by about that much).
         teb: The band's settings.
+        straddle: What is passed between the feet, and how.
     """
 
     planner_hz: float = 10.0
@@ -94,6 +105,7 @@ class NavigatorSettings:
     obstacle_radius: float = 2.5
     command_horizon: float = 0.5
     teb: TebSettings = field(default_factory=TebSettings)
+    straddle: StraddleSettings = field(default_factory=StraddleSettings)
 
 
 class Navigator:
@@ -136,6 +148,9 @@ class Navigator:
         self.costmap: Costmap | None = None
         self._command = (0.0, 0.0, 0.0)  # (time, speed, yaw rate) of the last command
         self._target = (0.0, 0.0)
+        self._spread = (0.0, 0.0, 0.0)  # (time, offset, target offset) of the feet [s, m, m]
+        self.straddles: tuple[Straddle, ...] = ()
+        self.straddle_times: list[float] = []  # update times at which the feet were spread
         self._decel = s.accel
         self._failures_in_row = 0
         self.arrived_at: float | None = None
@@ -160,7 +175,14 @@ class Navigator:
         w = w0 + float(
             np.clip(w1 - w0, -self.settings.yaw_accel * dt, self.settings.yaw_accel * dt)
         )
-        return Command.model_construct(velocity=v, yaw_rate=w)
+        t1, offset, wanted = self._spread
+        rate = self.settings.straddle.spread_rate * max(0.0, t - t1)
+        offset += float(np.clip(wanted - offset, -rate, rate))
+        return Command.model_construct(velocity=v, yaw_rate=w, lateral_offset=offset)
+
+    def _respread(self, t: float, offset: float) -> None:
+        if offset != self._spread[2]:
+            self._spread = (t, self.command_at(t).lateral_offset, offset)
 
     def _retarget(self, t: float, speed: float, yaw_rate: float) -> None:
         now = self.command_at(t)
@@ -213,6 +235,9 @@ class Navigator:
             return
         base, rotation = pose
         yaw = math.atan2(rotation[1, 0], rotation[0, 0])
+        self._respread(t, self._straddle_spread(base[:2]))
+        if self._spread[2] > 0.0:
+            self.straddle_times.append(t)
         to_goal = float(np.hypot(*(self.goal - base[:2])))
         if self.arrived_at is None and to_goal <= self.settings.arrive:
             self._command = (t, 0.0, 0.0)  # a step: the riders brake as they were built to
@@ -251,42 +276,60 @@ class Navigator:
         self._decel = self.settings.accel
         self._retarget(t, v, w)
 
+    def _straddle_spread(self, position: Array) -> float:
+        """The feet's lateral offset wanted at ``position`` [m]: spread within the lead of
+        a straddle and near its axis (wider than its lane: once lined up, spread)."""
+        st = self.settings.straddle
+        for straddle in self.straddles:
+            if straddle.in_lane(position, st.lane + straddle.half_width, st.lead):
+                return st.spread
+        return 0.0
+
     def _replan(self, start: Array, t: float) -> bool:
-        s = self.settings
         began = time.perf_counter()
-        costmap = inflate(self.grid.frame, self.grid.occupied(), s.inscribed, s.decay)
-        costmap.cost[~self.grid.observed] += s.unknown_cost
-        costmap = costmap.coarsened(s.global_coarsening)
-        self.costmap = costmap
+        grid = self.grid
         try:
-            path = plan(costmap, _free_start(costmap, start), self.goal)
+            planned = plan_global(
+                grid.frame,
+                grid.occupied(),
+                grid.height,
+                grid.observed,
+                start,
+                self.goal,
+                self.settings,
+            )
         except NoPath as exc:
             self.global_times.append(time.perf_counter() - began)
             self._stop(t, f"global planner: {exc}")
             return False
         self.global_times.append(time.perf_counter() - began)
-        self.path = path
-        self.paths.append(path)
+        self.costmap, self.straddles = planned.costmap, planned.straddles
+        self.path = planned.path
+        self.paths.append(self.path)
         return True
 
     def _local_goal(self, position: Array) -> Array:
-        """The pose ``LOOK_AHEAD`` along the global path from its point nearest the rider."""
+        """The pose ``LOOK_AHEAD`` along the global path from its point nearest the rider
+        (the straddle's shorter look-ahead while the feet are spread: a lateral error is
+        closed over about that distance)."""
+        ahead = self.settings.straddle.look_ahead if self._spread[2] > 0.0 else LOOK_AHEAD
         path = self.path
         nearest = int(np.argmin(np.linalg.norm(path - position, axis=1)))
         rest = np.vstack([position, path[nearest:], self.goal])
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(rest, axis=0), axis=1))])
-        if arc[-1] <= LOOK_AHEAD:
+        if arc[-1] <= ahead:
             d = rest[-1] - rest[max(0, len(rest) - 6)]
             return np.array([*self.goal, math.atan2(d[1], d[0])])
-        k = int(np.searchsorted(arc, LOOK_AHEAD))
+        k = int(np.searchsorted(arc, ahead))
         point = rest[k]
         d = rest[min(len(rest) - 1, k + 3)] - rest[max(0, k - 3)]
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        return nearby_cells(
-            self.grid.frame, self.grid.occupied(), position, self.settings.obstacle_radius
-        )
+        obstacles = self.grid.occupied()
+        for straddle in self.straddles:
+            obstacles &= ~straddle.cells
+        return nearby_obstacles(self.grid.frame, obstacles, self.straddles, position, self.settings)
 
     def trace_arrays(self) -> dict[str, Array]:
         """Every band's time [s], command (speed [m/s], yaw rate [rad/s]) and local goal
@@ -317,7 +360,37 @@ class Navigator:
             "teb_updates": len(self.teb_times),
             "global_plans": len(self.global_times),
             "frames_fused": len(self.perception_times),
+            "straddles": [
+                {
+                    "center_m": [round(float(v), 3) for v in st.center],
+                    "axis": [round(float(v), 3) for v in st.axis],
+                    "width_m": round(2.0 * st.half_width, 3),
+                    "length_m": round(2.0 * st.half_length, 3),
+                    "height_m": round(st.height, 3),
+                }
+                for st in self.straddles
+            ],
+            "feet_spread_s": round(len(self.straddle_times) / self.settings.planner_hz, 2),
         }
+
+
+def nearby_obstacles(
+    frame: GridFrame,
+    obstacles: NDArray[np.bool_],
+    straddles: tuple[Straddle, ...],
+    position: Array,
+    settings: NavigatorSettings,
+) -> Array:
+    """The band's obstacle points: the obstacle cells within ``obstacle_radius`` of
+    ``position`` and, for each straddle that near, the walls of its lane."""
+    s = settings
+    cells = nearby_cells(frame, obstacles, position, s.obstacle_radius)
+    walls = [
+        lane_walls(straddle, s.teb.d_min, s.straddle.lane)
+        for straddle in straddles
+        if np.linalg.norm(straddle.center - position) <= s.obstacle_radius
+    ]
+    return np.vstack([cells, *walls]) if walls else cells
 
 
 def nearby_cells(
@@ -332,21 +405,6 @@ def nearby_cells(
         ]
     )
     return xy[np.linalg.norm(xy - position, axis=1) <= radius]
-
-
-def _free_start(costmap: Costmap, start: Array) -> Array:
-    """The start, or the nearest cell outside the inscribed radius when the rider stands
-    within it (a noisy map next to a box): the rider gets out the cheapest way."""
-    if not costmap.lethal_at(start):
-        return start
-    x, y = costmap.frame.centers()
-    free = np.isfinite(costmap.cost)
-    if not free.any():
-        return start
-    d = np.hypot(x - start[0], y - start[1])
-    d[~free] = np.inf
-    k = np.unravel_index(int(np.argmin(d)), d.shape)
-    return np.array([x[k], y[k]])
 
 
 def _stats(seconds: list[float]) -> dict[str, float | None]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -41,8 +42,13 @@ def obstacle_geoms(model: mujoco.MjModel) -> list[int]:
     ]
 
 
-def place_obstacles(model: mujoco.MjModel, shift: np.ndarray) -> None:
+def place_obstacles(
+    model: mujoco.MjModel, shift: np.ndarray, level: Callable[[float], float] | None = None
+) -> None:
     """Move the boxes by ``shift`` (x, y) [m]: the course's start frame onto the rider's
-    starting base, which the scene builder places."""
+    starting base, which the scene builder places; and each onto the ground's ``level`` [m]
+    at its world x (the terrain's profile), if given."""
     for g in obstacle_geoms(model):
         model.geom_pos[g, :2] += shift
+        if level is not None:
+            model.geom_pos[g, 2] += level(float(model.geom_pos[g, 0]))

@@ -57,14 +57,19 @@ class OccupancyGrid:
         self.frame = frame
         self.log_odds = np.zeros(frame.shape)
         self.observed = np.zeros(frame.shape, dtype=bool)
+        # tallest obstacle point seen in each cell over the ground [m]; -inf: none seen
+        self.height = np.full(frame.shape, -np.inf)
 
-    def update(self, sensor: Array, ground: Array, obstacles: Array) -> None:
+    def update(
+        self, sensor: Array, ground: Array, obstacles: Array, heights: Array | None = None
+    ) -> None:
         """Fuse one frame's segmented points.
 
         Args:
             sensor: Camera position in the world [m], (3,).
             ground: Ground points [m], shape (n, 3).
             obstacles: Obstacle points [m], shape (m, 3).
+            heights: Each obstacle point's height over the ground under it [m], (m,).
         """
         frame = self.frame
         free = np.zeros(frame.shape, dtype=bool)
@@ -75,6 +80,8 @@ class OccupancyGrid:
         free[ij[inside, 0], ij[inside, 1]] = True
         ij, inside = frame.cells(obstacles[:, :2])
         hit[ij[inside, 0], ij[inside, 1]] = True
+        if heights is not None:
+            np.maximum.at(self.height, (ij[inside, 0], ij[inside, 1]), heights[inside])
         free &= ~hit
         self.log_odds[free] += L_FREE
         self.log_odds[hit] += L_OCCUPIED

@@ -2,7 +2,8 @@
 
 depth image --(estimated camera pose)--> world points --> voxel filter (5 x 5 x 10 cm)
 --> ground segmentation --> global occupancy grid and a pseudo-laser scan. Points within
-``self_radius`` of the estimated base are the rider and its board, not obstacles.
+``self_radius`` of the estimated base are the rider and its board, not obstacles; depths
+beyond ``fuse_range`` are not fused.
 """
 
 from __future__ import annotations
@@ -24,6 +25,10 @@ __all__ = ["Perception", "PerceivedFrame"]
 Array = NDArray[np.float64]
 
 SELF_RADIUS: float = 0.45  # [m] Cassie's stance on the shoes seen from the pelvis, with margin
+# [m] Stereo depth's sigma = 0.004 z^2 is 0.036 m at 3 m, most of a 5 cm cell: farther, the
+# top of a wall reads cells behind its far face, which no later ray clears (the camera never
+# sees the ground there).
+FUSE_RANGE: float = 3.0
 
 
 @dataclass(frozen=True)
@@ -51,15 +56,22 @@ class Perception:
         rays: The camera's :func:`~ridempc.autonomy.camera.pixel_rays`.
         fov: The camera's horizontal field of view [rad] (the scan's width).
         self_radius: Points this close to the base, horizontally, are the rider [m].
+        fuse_range: Depths beyond this are left out [m].
     """
 
     def __init__(
-        self, grid: OccupancyGrid, rays: Array, fov: float, self_radius: float = SELF_RADIUS
+        self,
+        grid: OccupancyGrid,
+        rays: Array,
+        fov: float,
+        self_radius: float = SELF_RADIUS,
+        fuse_range: float = FUSE_RANGE,
     ) -> None:
         self.grid = grid
         self.rays = rays
         self.fov = fov
         self.self_radius = self_radius
+        self.fuse_range = fuse_range
 
     def update(
         self, depth: Array, rotation: Array, position: Array, base: Array, yaw: float
@@ -74,10 +86,11 @@ class Perception:
             yaw: Estimated heading [rad].
         """
         began = time.perf_counter()
+        depth = np.where(depth <= self.fuse_range, depth, 0.0)  # 0: nothing seen
         points = to_points(depth, self.rays, rotation, position)
         away = np.hypot(points[:, 0] - base[0], points[:, 1] - base[1]) > self.self_radius
         voxels = voxel_filter(points[away])
         split = segment_ground(voxels)
-        self.grid.update(position, split.ground, split.obstacles)
+        self.grid.update(position, split.ground, split.obstacles, split.obstacle_heights)
         scan = pseudo_scan(split.obstacles, base[:2], yaw, self.fov)
         return PerceivedFrame(split.ground, split.obstacles, scan, time.perf_counter() - began)

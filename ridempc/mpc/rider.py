@@ -100,6 +100,7 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.handover import (
@@ -176,8 +177,9 @@ class _BuildInputs(NamedTuple):
     turn over its steps [rad/s], the turn so far [rad], whether the rider coasts, whether
     the manoeuvre switched at this tick, the lean loop (a copy, or None), the shoes'
     observer (frozen, or None), the manoeuvre's kind and target, the plan in force's
-    first input (or None), the contacts of the last MPC step, and the reference tracked
-    when it changed at this tick (else None)."""
+    first input (or None), the contacts of the last MPC step, the reference tracked
+    when it changed at this tick (else None), whether any manoeuvre began at this tick,
+    and the commanded lateral offset of the feet [m] (:mod:`~ridempc.mpc.foot_spread`)."""
 
     t_ref: float
     x0: Array
@@ -195,6 +197,8 @@ class _BuildInputs(NamedTuple):
     first_input: Array | None
     contacts: tuple[Contact, ...]
     reference: MotionReference | None
+    began: bool
+    lateral_offset: float
 
 
 class _Built(NamedTuple):
@@ -627,7 +631,8 @@ class MpcRider(Controller):
         )
         if wanted is self.manoeuvre and self._coasting(self.manoeuvre.reference_time(now)):
             wanted = self.selector.repush(command, wanted, now, speed)  # slowed: push again
-        if wanted is not self.manoeuvre:
+        began = wanted is not self.manoeuvre
+        if began:
             self.mpc.retarget(wanted.library_kind, wanted.target)
             reference = self.mpc.reference
             start = self.selector.phase_start(
@@ -640,10 +645,10 @@ class MpcRider(Controller):
             )
             self.manoeuvre = replace(wanted, start=start)
             switched = wanted.kind == REPUSH  # from wherever the coast left the rider
-            # a re-push starts mid-turn: the reference's heading already carries the turn
+            # any switch starts mid-turn: the reference's heading already carries the turn
             # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
-            # turn back at once and fell in the push)
-            self._anchor(estimate, now, self._turned if switched else 0.0)
+            # turn back at once and fell in the push; one 0.67 rad into a course, in a stop)
+            self._anchor(estimate, now, self._turned)
         else:
             switched = False
         t_ref = self.manoeuvre.reference_time(now)
@@ -658,6 +663,8 @@ class MpcRider(Controller):
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
+        if self.shoes is not None:  # the frame follows platform 0 onto its spread line
+            here = spread_lines(here[None, :], self._shoe_columns, command.lateral_offset)[0]
         yaw_rate = estimate.yaw_rate
         if self.lean is not None:
             self.lean.update(now, command.yaw_rate, yaw_rate, speed)
@@ -691,6 +698,8 @@ class MpcRider(Controller):
             self._plan.first_input if self._plan is not None else None,
             self._contacts,
             None if self.mpc.reference is self._sent_reference else self.mpc.reference,
+            began,
+            command.lateral_offset,
         )
         self._sent_reference = self.mpc.reference
         # the frame the plan is in: the map's moves on at the next tick, the plan only
@@ -750,7 +759,7 @@ class MpcRider(Controller):
         re-push's blend, the turn, the crouch, the lean, the shoes' lines and drags and
         the swing's held forces."""
         names, t_ref, speed = self.layout.names, inputs.t_ref, inputs.speed
-        if inputs.switched:  # a re-push's blend starts again
+        if inputs.began:  # any new manoeuvre ends a re-push's blend (a re-push starts its own)
             self._blend = None
         # A re-push before its first push (while its blend runs) coasts too, its speeds
         # scaled to the board's: the entry's planned body speed, faster than a deck that
@@ -777,7 +786,7 @@ class MpcRider(Controller):
             problem = lean.turn(problem, names)
         if inputs.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
-            states = problem.state_reference
+            states = spread_lines(problem.state_reference, columns, inputs.lateral_offset)
             if self._guidance:
                 states = steer_onto_lines(states, problem.initial_state, columns)
             states = inputs.shoes.shift_reference(states, columns)
