@@ -64,6 +64,7 @@ from numpy.typing import NDArray
 from ridempc.baselines.cassie_kinematics import SIDES, KinematicState, LegIndices
 from ridempc.baselines.cassie_standing import CassieStanding, StandingTargets
 from ridempc.baselines.filters import LowPassFilter
+from ridempc.baselines.hovershoe_flight import unloaded_feet
 from ridempc.baselines.hovershoe_gains import (
     DEFAULT_GAINS_FILE,
     CassieHovershoesGains,
@@ -122,6 +123,9 @@ class CassieHovershoes(CassieStanding):
         self._yaw_rate = 0.0
         self._yaw_integral = 0.0
         self._integral_time: float | None = None
+        self._unloaded = np.zeros(2, dtype=bool)
+        self._loaded_com_x = np.zeros(2)  # CoM x over the feet and its rate, last loaded
+        self._loaded_toe = np.zeros(2)  # each toe motor's angle, last loaded [rad]
 
     # ------------------------------------------------------------------ state
 
@@ -132,6 +136,9 @@ class CassieHovershoes(CassieStanding):
         self._half_spacing = 0.5 * float(feet[0, 1] - feet[1, 1])
         self._yaw_integral = 0.0
         self._integral_time = None
+        self._unloaded[:] = False
+        self._loaded_com_x[:] = 0.0
+        self._loaded_toe = self._toe_angles(sensors)
         for low_pass in (
             self._speed_filter,
             self._yaw_rate_filter,
@@ -279,6 +286,54 @@ class CassieHovershoes(CassieStanding):
             self._yaw_integral = min(max(self._yaw_integral + error * dt, -bound), bound)
         return self._yaw_integral
 
+    # ------------------------------------------------------------------ flight
+
+    def _toe_angles(self, sensors: SensorPacket) -> Array:
+        """Each toe motor's angle (left, right) [rad]."""
+        q = self.kinematic_state(sensors).motor_position
+        return np.array([q[self.kinematics.legs[s].motors[LegIndices.TOE]] for s in SIDES])
+
+    def flight_state(self, state: KinematicState) -> KinematicState:
+        """The state the CoP law reads: its CoM x and rate held while a foot is unloaded.
+
+        Records which feet are unloaded (:func:`unloaded_feet`, from the shin springs) and,
+        while both are loaded, the CoM x over the feet, its rate and the toe angles.
+        """
+        gains = self.rider_gains.flight
+        shins = np.array([state.q[self.kinematics.legs[s].q[LegIndices.SHIN]] for s in SIDES])
+        self._unloaded = unloaded_feet(shins, gains.unloaded_shin)
+        if gains.unloaded_shin == 0.0:
+            return state
+        if not self._unloaded.any():
+            self._loaded_com_x = np.array([state.com_offset[0], state.com_velocity[0]])
+            q = state.motor_position
+            self._loaded_toe = np.array(
+                [q[self.kinematics.legs[s].motors[LegIndices.TOE]] for s in SIDES]
+            )
+            return state
+        com = state.com.copy()
+        com[0] = state.support_centre[0] + self._loaded_com_x[0]
+        com_velocity = state.com_velocity.copy()
+        com_velocity[0] = self._loaded_com_x[1]
+        return dataclasses.replace(state, com=com, com_velocity=com_velocity)
+
+    def hold_ankles(self, command: MotorCommand) -> MotorCommand:
+        """An unloaded foot's toe held at its last loaded angle, no torque fed forward."""
+        if not self._unloaded.any() or self.rider_gains.flight.unloaded_shin == 0.0:
+            return command
+        torque, position = command.torque.copy(), command.position.copy()
+        kp = command.kp.copy()
+        for i, side in enumerate(SIDES):
+            if self._unloaded[i]:
+                toe = self.kinematics.legs[side].motors[LegIndices.TOE]
+                torque[toe] = 0.0
+                position[toe] = self._loaded_toe[i]
+                kp[toe] = self.rider_gains.flight.kp_toe
+        self._diagnostics.update(
+            left_unloaded=float(self._unloaded[0]), right_unloaded=float(self._unloaded[1])
+        )
+        return dataclasses.replace(command, torque=torque, position=position, kp=kp)
+
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         if self._nominal is None:
             self.reset(sensors)
@@ -286,8 +341,10 @@ class CassieHovershoes(CassieStanding):
         else:
             estimate = self.estimator.update(sensors)
         assert estimate is not None
-        state = self.kinematic_state(sensors)
+        state = self.flight_state(self.kinematic_state(sensors))
         speed, yaw_rate = self._estimated_motion(estimate, sensors.time)
         targets, y_offset = self.rider_targets(state, command, speed, yaw_rate)
         nominal = self.motor_command(state, targets)
-        return self.rider_command(state, command, nominal, y_offset, speed, yaw_rate)
+        return self.hold_ankles(
+            self.rider_command(state, command, nominal, y_offset, speed, yaw_rate)
+        )
