@@ -125,7 +125,7 @@ class CassieHovershoes(CassieStanding):
         self._integral_time: float | None = None
         self._unloaded = np.zeros(2, dtype=bool)
         self._loaded_com_x = np.zeros(2)  # CoM x over the feet and its rate, last loaded
-        self._loaded_toe = np.zeros(2)  # each toe motor's angle, last loaded [rad]
+        self._loaded_pitch = np.zeros(2)  # each foot's pitch, last loaded [rad]
 
     # ------------------------------------------------------------------ state
 
@@ -138,7 +138,7 @@ class CassieHovershoes(CassieStanding):
         self._integral_time = None
         self._unloaded[:] = False
         self._loaded_com_x[:] = 0.0
-        self._loaded_toe = self._toe_angles(sensors)
+        self._loaded_pitch = self._foot_pitches(self.kinematic_state(sensors))
         for low_pass in (
             self._speed_filter,
             self._yaw_rate_filter,
@@ -288,16 +288,11 @@ class CassieHovershoes(CassieStanding):
 
     # ------------------------------------------------------------------ flight
 
-    def _toe_angles(self, sensors: SensorPacket) -> Array:
-        """Each toe motor's angle (left, right) [rad]."""
-        q = self.kinematic_state(sensors).motor_position
-        return np.array([q[self.kinematics.legs[s].motors[LegIndices.TOE]] for s in SIDES])
-
     def flight_state(self, state: KinematicState) -> KinematicState:
         """The state the CoP law reads: its CoM x and rate held while a foot is unloaded.
 
         Records which feet are unloaded (:func:`unloaded_feet`, from the shin springs) and,
-        while both are loaded, the CoM x over the feet, its rate and the toe angles.
+        while both are loaded, the CoM x over the feet, its rate and the feet's pitches.
         """
         gains = self.rider_gains.flight
         shins = np.array([state.q[self.kinematics.legs[s].q[LegIndices.SHIN]] for s in SIDES])
@@ -306,10 +301,7 @@ class CassieHovershoes(CassieStanding):
             return state
         if not self._unloaded.any():
             self._loaded_com_x = np.array([state.com_offset[0], state.com_velocity[0]])
-            q = state.motor_position
-            self._loaded_toe = np.array(
-                [q[self.kinematics.legs[s].motors[LegIndices.TOE]] for s in SIDES]
-            )
+            self._loaded_pitch = self._foot_pitches(state)
             return state
         com = state.com.copy()
         com[0] = state.support_centre[0] + self._loaded_com_x[0]
@@ -317,22 +309,31 @@ class CassieHovershoes(CassieStanding):
         com_velocity[0] = self._loaded_com_x[1]
         return dataclasses.replace(state, com=com, com_velocity=com_velocity)
 
-    def hold_ankles(self, command: MotorCommand) -> MotorCommand:
-        """An unloaded foot's toe held at its last loaded angle, no torque fed forward."""
+    def hold_ankles(self, state: KinematicState, command: MotorCommand) -> MotorCommand:
+        """An unloaded foot's toe turned to keep the foot at its last loaded pitch in the
+        world (the shoe lands as it left), no torque fed forward."""
         if not self._unloaded.any() or self.rider_gains.flight.unloaded_shin == 0.0:
             return command
         torque, position = command.torque.copy(), command.position.copy()
         kp = command.kp.copy()
+        pitches = self._foot_pitches(state)
         for i, side in enumerate(SIDES):
             if self._unloaded[i]:
                 toe = self.kinematics.legs[side].motors[LegIndices.TOE]
                 torque[toe] = 0.0
-                position[toe] = self._loaded_toe[i]
+                error = pitches[i] - self._loaded_pitch[i]
+                position[toe] = state.motor_position[toe] - error
                 kp[toe] = self.rider_gains.flight.kp_toe
         self._diagnostics.update(
             left_unloaded=float(self._unloaded[0]), right_unloaded=float(self._unloaded[1])
         )
         return dataclasses.replace(command, torque=torque, position=position, kp=kp)
+
+    @staticmethod
+    def _foot_pitches(state: KinematicState) -> Array:
+        """Each foot's pitch in the heading frame (left, right) [rad], positive nose up."""
+        axes = state.contacts[0::2] - state.contacts[1::2]  # front minus back
+        return np.arctan2(axes[:, 2], np.hypot(axes[:, 0], axes[:, 1]))
 
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         if self._nominal is None:
@@ -346,5 +347,5 @@ class CassieHovershoes(CassieStanding):
         targets, y_offset = self.rider_targets(state, command, speed, yaw_rate)
         nominal = self.motor_command(state, targets)
         return self.hold_ankles(
-            self.rider_command(state, command, nominal, y_offset, speed, yaw_rate)
+            state, self.rider_command(state, command, nominal, y_offset, speed, yaw_rate)
         )

@@ -10,8 +10,9 @@ the light shoe about its axle.
 
 While a foot is unloaded, :class:`~ridempc.baselines.cassie_hovershoes.CassieHovershoes`
 
-- holds its ankle (toe motor) at the angle it had when the foot was last loaded, so the
-  shoe keeps its pitch through the flight and lands level, and
+- turns its ankle (toe motor, no torque fed forward) to keep the foot at the pitch in the
+  world it had when last loaded (from the IMU and the leg's kinematics), so the shoe keeps
+  its pitch through the flight and lands as it left, and
 - holds the CoM's position and velocity over the feet that the centre-of-pressure law
   reads at their last loaded values (the falling feet are not the rider tipping back).
 """

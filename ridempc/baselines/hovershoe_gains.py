@@ -120,7 +120,7 @@ class FlightGains(_Frozen):
         description="Shin deflection below which a foot is unloaded [rad]; 0 = never.",
     )
     kp_toe: NonNegative = Field(
-        0.0, description="Stiffness holding an unloaded foot's ankle at its last angle [N m/rad]."
+        0.0, description="Stiffness holding an unloaded foot at its last pitch [N m/rad]."
     )
 
 
