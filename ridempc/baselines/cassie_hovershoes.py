@@ -48,6 +48,12 @@ controller does not; on two independent shoes the legs must carry the fore-aft f
 turn the pair, so ``leg_angle`` adds :math:`\\mp k_p (\\theta_L - \\theta_R)/2` on the hip
 pitches (:math:`\\theta` the virtual leg angles). Without it a turn only staggers the shoes.
 
+A shoe in the air (a step's drop; :mod:`ridempc.baselines.hovershoe_flight`, ``[flight]``):
+while a leg's shin spring says its foot is unloaded, that toe gets no torque fed forward
+and keeps the foot at its last loaded pitch in the world, and the CoP law reads the CoM x
+over the feet held at its last loaded value. On flat ground no shin relaxes and the law
+above is the paper's.
+
 The controller runs the state estimator every tick with one platform per foot (left foot
 on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Gains:
 ``cassie_hovershoes.toml`` (:mod:`ridempc.baselines.hovershoe_gains`).
