@@ -48,6 +48,12 @@ controller does not; on two independent shoes the legs must carry the fore-aft f
 turn the pair, so ``leg_angle`` adds :math:`\\mp k_p (\\theta_L - \\theta_R)/2` on the hip
 pitches (:math:`\\theta` the virtual leg angles). Without it a turn only staggers the shoes.
 
+A shoe in the air (a step's drop; :mod:`ridempc.baselines.hovershoe_flight`, ``[flight]``):
+while a leg's shin spring says its foot is unloaded, that toe gets no torque fed forward
+and keeps the foot at its last loaded pitch in the world, and the CoP law reads the CoM x
+over the feet held at its last loaded value. On flat ground no shin relaxes and the law
+above is the paper's.
+
 The controller runs the state estimator every tick with one platform per foot (left foot
 on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Gains:
 ``cassie_hovershoes.toml`` (:mod:`ridempc.baselines.hovershoe_gains`).
@@ -64,6 +70,7 @@ from numpy.typing import NDArray
 from ridempc.baselines.cassie_kinematics import SIDES, KinematicState, LegIndices
 from ridempc.baselines.cassie_standing import CassieStanding, StandingTargets
 from ridempc.baselines.filters import LowPassFilter
+from ridempc.baselines.hovershoe_flight import unloaded_feet
 from ridempc.baselines.hovershoe_gains import (
     DEFAULT_GAINS_FILE,
     CassieHovershoesGains,
@@ -122,6 +129,9 @@ class CassieHovershoes(CassieStanding):
         self._yaw_rate = 0.0
         self._yaw_integral = 0.0
         self._integral_time: float | None = None
+        self._unloaded = np.zeros(2, dtype=bool)
+        self._loaded_com_x = np.zeros(2)  # CoM x over the feet and its rate, last loaded
+        self._loaded_pitch = np.zeros(2)  # each foot's pitch, last loaded [rad]
 
     # ------------------------------------------------------------------ state
 
@@ -132,6 +142,9 @@ class CassieHovershoes(CassieStanding):
         self._half_spacing = 0.5 * float(feet[0, 1] - feet[1, 1])
         self._yaw_integral = 0.0
         self._integral_time = None
+        self._unloaded[:] = False
+        self._loaded_com_x[:] = 0.0
+        self._loaded_pitch = self._foot_pitches(self.kinematic_state(sensors))
         for low_pass in (
             self._speed_filter,
             self._yaw_rate_filter,
@@ -279,6 +292,55 @@ class CassieHovershoes(CassieStanding):
             self._yaw_integral = min(max(self._yaw_integral + error * dt, -bound), bound)
         return self._yaw_integral
 
+    # ------------------------------------------------------------------ flight
+
+    def flight_state(self, state: KinematicState) -> KinematicState:
+        """The state the CoP law reads: its CoM x and rate held while a foot is unloaded.
+
+        Records which feet are unloaded (:func:`unloaded_feet`, from the shin springs) and,
+        while both are loaded, the CoM x over the feet, its rate and the feet's pitches.
+        """
+        gains = self.rider_gains.flight
+        shins = np.array([state.q[self.kinematics.legs[s].q[LegIndices.SHIN]] for s in SIDES])
+        self._unloaded = unloaded_feet(shins, gains.unloaded_shin)
+        if gains.unloaded_shin == 0.0:
+            return state
+        if not self._unloaded.any():
+            self._loaded_com_x = np.array([state.com_offset[0], state.com_velocity[0]])
+            self._loaded_pitch = self._foot_pitches(state)
+            return state
+        com = state.com.copy()
+        com[0] = state.support_centre[0] + self._loaded_com_x[0]
+        com_velocity = state.com_velocity.copy()
+        com_velocity[0] = self._loaded_com_x[1]
+        return dataclasses.replace(state, com=com, com_velocity=com_velocity)
+
+    def hold_ankles(self, state: KinematicState, command: MotorCommand) -> MotorCommand:
+        """An unloaded foot's toe turned to keep the foot at its last loaded pitch in the
+        world (the shoe lands as it left), no torque fed forward."""
+        if not self._unloaded.any() or self.rider_gains.flight.unloaded_shin == 0.0:
+            return command
+        torque, position = command.torque.copy(), command.position.copy()
+        kp = command.kp.copy()
+        pitches = self._foot_pitches(state)
+        for i, side in enumerate(SIDES):
+            if self._unloaded[i]:
+                toe = self.kinematics.legs[side].motors[LegIndices.TOE]
+                torque[toe] = 0.0
+                error = pitches[i] - self._loaded_pitch[i]
+                position[toe] = state.motor_position[toe] - error
+                kp[toe] = self.rider_gains.flight.kp_toe
+        self._diagnostics.update(
+            left_unloaded=float(self._unloaded[0]), right_unloaded=float(self._unloaded[1])
+        )
+        return dataclasses.replace(command, torque=torque, position=position, kp=kp)
+
+    @staticmethod
+    def _foot_pitches(state: KinematicState) -> Array:
+        """Each foot's pitch in the heading frame (left, right) [rad], positive nose up."""
+        axes = state.contacts[0::2] - state.contacts[1::2]  # front minus back
+        return np.arctan2(axes[:, 2], np.hypot(axes[:, 0], axes[:, 1]))
+
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         if self._nominal is None:
             self.reset(sensors)
@@ -286,8 +348,10 @@ class CassieHovershoes(CassieStanding):
         else:
             estimate = self.estimator.update(sensors)
         assert estimate is not None
-        state = self.kinematic_state(sensors)
+        state = self.flight_state(self.kinematic_state(sensors))
         speed, yaw_rate = self._estimated_motion(estimate, sensors.time)
         targets, y_offset = self.rider_targets(state, command, speed, yaw_rate)
         nominal = self.motor_command(state, targets)
-        return self.rider_command(state, command, nominal, y_offset, speed, yaw_rate)
+        return self.hold_ankles(
+            state, self.rider_command(state, command, nominal, y_offset, speed, yaw_rate)
+        )

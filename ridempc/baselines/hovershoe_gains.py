@@ -111,6 +111,19 @@ class ToeDampingGains(_Frozen):
     kd: NonNegative = Field(description="Toe damping [N m s/rad].")
 
 
+class FlightGains(_Frozen):
+    """A shoe in the air (:mod:`ridempc.baselines.hovershoe_flight`): its ankle held, the CoP
+    law's CoM reading held, while the leg's shin spring says the foot is unloaded."""
+
+    unloaded_shin: Annotated[Real, Field(ge=0.0, le=0.1)] = Field(
+        0.0,
+        description="Shin deflection below which a foot is unloaded [rad]; 0 = never.",
+    )
+    kp_toe: NonNegative = Field(
+        0.0, description="Stiffness holding an unloaded foot at its last pitch [N m/rad]."
+    )
+
+
 class CassieHovershoesGains(_Frozen):
     """Checked, immutable gains of the Hovershoe controller."""
 
@@ -120,6 +133,7 @@ class CassieHovershoesGains(_Frozen):
     turning: TurningGains
     toe_damping: ToeDampingGains
     leg_angle: LegAngleGains
+    flight: FlightGains = FlightGains()
     standing: CassieStandingGains
 
 
