@@ -128,6 +128,7 @@ from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
+from ridempc.mpc.stagger import standby_phase
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
@@ -482,7 +483,9 @@ class MpcRider(Controller):
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
-        self.handover = Handover(law, standby_every=STANDBY_DIVIDER if shared else 1)
+        self.handover = Handover(  # off the MPC's tick and the plan's (mpc/stagger.py)
+            law, STANDBY_DIVIDER if shared else 1, standby_phase=standby_phase(MPC_DIVIDER, latency)
+        )
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
