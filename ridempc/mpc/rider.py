@@ -483,8 +483,10 @@ class MpcRider(Controller):
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
-        self.handover = Handover(  # off the MPC's tick and the plan's (mpc/stagger.py)
-            law, STANDBY_DIVIDER if shared else 1, standby_phase=standby_phase(MPC_DIVIDER, latency)
+        self.handover = Handover(
+            law,
+            standby_every=STANDBY_DIVIDER if shared else 1,
+            standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
         self._diagnostics: dict[str, float] = {}
 
