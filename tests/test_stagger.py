@@ -8,9 +8,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ridempc.mpc.handover import STANDBY_DIVIDER, Handover
-from ridempc.mpc.rider import MPC_DIVIDER
+from ridempc.mpc.handover import BLEND_S, STANDBY_DIVIDER, Handover
+from ridempc.mpc.rider import MPC_DIVIDER, MpcRider
 from ridempc.mpc.stagger import standby_phase
+from ridempc.robots.robot import load_robot
 from ridempc.sim.motors import MotorCommand
 
 
@@ -56,3 +57,11 @@ def test_the_handover_runs_the_standby_on_its_phase() -> None:
         primary = MotorCommand.hold((), np.zeros(0))
         handover.step(SimpleNamespace(time=k * 0.002), None, primary, None, True)  # type: ignore[arg-type]
     assert backup.ran == [0, 8, 23, 38]  # its first tick, then the phase of each period
+
+
+@pytest.mark.parametrize("latency", [0, 2, 7])
+def test_the_rider_staggers_its_standby(latency: int) -> None:
+    rider = MpcRider(load_robot("cassie"), "hovershoes", plan_latency=latency)
+    handover = rider.handover
+    assert handover.standby_every == STANDBY_DIVIDER and handover.blend_s == BLEND_S
+    assert handover.standby_phase == standby_phase(MPC_DIVIDER, latency)
