@@ -44,11 +44,11 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     after the state it starts from (the first at once), timed from that state; the ticks
     between follow the previous plan. The ride does not depend on how fast the thread or
     the process runs, nor on where the MPC runs (the process, the thread, the tick): the
-    rides are the same, bit for bit. The Hovershoes ride so; the skateboard and the Segway
-    take each plan up two ticks on, from the process (the pairs' ``plan_latency``)."""
+    rides are the same, bit for bit. The Hovershoes ride so, the Segway two ticks on (from
+    the process); the skateboard waits for each plan in its tick (the pairs' ``plan_latency``)."""
     assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
     assert load_mpc_pair("cassie", "segway").plan_latency == 2
-    assert MpcRider(dog, "skateboard").plan_latency == 2
+    assert MpcRider(dog, "skateboard").plan_latency == 0
     with pytest.raises(ValueError, match="plan_latency"):
         MpcRider(dog, "skateboard", plan_latency=MPC_DIVIDER)
     rider = MpcRider(dog, "skateboard", plan_latency=1)
@@ -240,7 +240,6 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
     roll rate, one MPC step on, is where the plan put it, and the board keeps the
     library's speed."""
     rider = MpcRider(dog, "skateboard")
-    rider.keeps_problems = True  # each plan's problem back from the solver process
     scenario = resolve_scenario("push-off-0.7", "skateboard").with_duration(2.5)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
     seen: list[tuple[float, tuple, tuple[str, ...], bool]] = []
@@ -329,22 +328,15 @@ def test_a_push_off_reaches_its_target_and_coasts_on(dog, seed: int) -> None:
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
     n = rider.layout.names
     coasting: list[tuple[float, float, float]] = []  # t, reference board speed, estimate's
-    mpc_tick, adopt = rider._mpc_tick, rider._adopt
-    rider.keeps_problems = True  # each plan's problem back from the solver process
-    speeds: dict[float, float] = {}  # the estimate's board speed at each coasting MPC tick
+    mpc_tick = rider._mpc_tick
 
     def recording(estimate, command, now):
         mpc_tick(estimate, command, now)
+        problem = rider._last_problem
         if rider._coasting(rider.manoeuvre.reference_time(now)):
-            speeds[now] = rider._speed(estimate)
+            coasting.append((now, problem.state_reference[0, n["board_v"]], rider._speed(estimate)))
 
-    def adopting(solve, built):  # the problem built at that tick, as its plan takes over
-        adopt(solve, built)
-        if solve.time in speeds:
-            reference = built.problem.state_reference[0, n["board_v"]]
-            coasting.append((solve.time, reference, speeds[solve.time]))
-
-    rider._mpc_tick, rider._adopt = recording, adopting
+    rider._mpc_tick = recording
     result = Simulation(scene, rider, scenario, seed=seed).run()
     assert result.status == "ok", result.fall_reason
     summary = run_metrics(result, scenario, dog)
