@@ -44,10 +44,10 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     after the state it starts from (the first at once), timed from that state; the ticks
     between follow the previous plan. The ride does not depend on how fast the thread or
     the process runs, nor on where the MPC runs (the process, the thread, the tick): the
-    rides are the same, bit for bit. The Hovershoes ride so; the
-    skateboard and the Segway wait for each plan in its tick (the pairs' ``plan_latency``)."""
+    rides are the same, bit for bit. The Hovershoes ride so, the Segway two ticks on (from
+    the process); the skateboard waits for each plan in its tick (the pairs' ``plan_latency``)."""
     assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
-    assert load_mpc_pair("cassie", "segway").plan_latency == 0
+    assert load_mpc_pair("cassie", "segway").plan_latency == 2
     assert MpcRider(dog, "skateboard").plan_latency == 0
     with pytest.raises(ValueError, match="plan_latency"):
         MpcRider(dog, "skateboard", plan_latency=MPC_DIVIDER)

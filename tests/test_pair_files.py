@@ -144,7 +144,7 @@ def _edited(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ),
         (
             "cassie-segway",
-            "plan_latency = 0",
+            "plan_latency = 2",
             "plan_latency = 15",
             "field 'mpc.plan_latency': Input should be less than 15, got 15",
         ),

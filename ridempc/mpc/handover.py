@@ -123,6 +123,8 @@ class Handover:
         standby_every: While the primary rides, the backup runs at every this many ticks
             (1: every tick, as it must with an estimator of its own); half a period after
             the first, off the ticks a primary with a slower loop of its own starts from.
+        standby_phase: The tick of each ``standby_every`` the standby runs on (None: half
+            a period, ``standby_every // 2``; :func:`~ridempc.mpc.stagger.standby_phase`).
 
     Attributes:
         fallbacks: Every handover so far, in order.
@@ -134,9 +136,11 @@ class Handover:
         blend_s: float = BLEND_S,
         dwell_s: float = RETURN_DWELL_S,
         standby_every: int = 1,
+        standby_phase: int | None = None,
     ) -> None:
         self.backup = backup
         self.standby_every = standby_every
+        self.standby_phase = standby_every // 2 if standby_phase is None else standby_phase
         self._ticks = 0
         self._backup_command: MotorCommand | None = None
         self.blend_s = blend_s
@@ -204,7 +208,7 @@ class Handover:
         its first tick, and every :attr:`standby_every` ticks in standby."""
         tick, self._ticks = self._ticks, self._ticks + 1
         every = self.standby_every
-        standby = tick % every == every // 2 if every > 1 else True
+        standby = tick % every == self.standby_phase if every > 1 else True
         if (
             self._backup_command is None
             or needed

@@ -11,12 +11,13 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Hovershoes the problem is built and
+   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Segway the problem is built and
    solved in a process of its own, as the robots run their MPC beside their WBC, from what
-   the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``), and the plan takes over one
-   tick, 2 ms, after the state it starts from, waited for then whatever the machine, the
-   tick between following the previous plan in its own library frame: the pair's
-   ``plan_latency``) on the manoeuvre the command asks for
+   the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``; on the Hovershoes in a
+   thread), and the plan takes over two ticks (4 ms; the Hovershoes one) after the state it
+   starts from, waited for then whatever the machine, the ticks between following the
+   previous plan in its own library frame: the pair's ``plan_latency``; the skateboard's is
+   built and solved in its tick) on the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
@@ -132,6 +133,7 @@ from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
+from ridempc.mpc.stagger import standby_phase
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.statics import StaticShift
@@ -495,7 +497,11 @@ class MpcRider(Controller):
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
-        self.handover = Handover(law, standby_every=STANDBY_DIVIDER if shared else 1)
+        self.handover = Handover(
+            law,
+            standby_every=STANDBY_DIVIDER if shared else 1,
+            standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
+        )
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
