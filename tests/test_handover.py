@@ -75,18 +75,6 @@ def test_a_failure_in_the_dwell_starts_it_again() -> None:
     assert handover.summary()[0]["duration_s"] == pytest.approx((back - 10) * DT)
 
 
-def test_starting_on_the_backup_hands_to_the_primary_once_fit_and_records_no_handover() -> None:
-    handover = Handover(_Backup(), dwell_s=0.1, start_on_backup=True)  # type: ignore[arg-type]
-    assert handover.on_backup and handover.primary_from_s is None
-    sent = _run(handover, 200, 0, range(0, 20))  # the primary fails its first 20 ticks
-    torque = np.array([c.torque[0] for c in sent])
-    first = 20 + round(0.1 / DT)  # fit from tick 20, then the dwell
-    assert np.all(torque[:first] == 1.0)  # the backup rides the start
-    assert 0.0 < torque[first + 1] < 1.0 and np.all(torque[first + round(BLEND_S / DT) :] == 0.0)
-    assert handover.primary_from_s == pytest.approx(first * DT)
-    assert handover.summary() == [] and handover.dwell() == pytest.approx(0.1)
-
-
 def test_blend_and_deviation() -> None:
     mixed = blend(_command(0.0), _command(2.0), 0.25)
     assert mixed.kp[0] == pytest.approx(0.5) and mixed.torque[0] == pytest.approx(0.5)

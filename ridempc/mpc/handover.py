@@ -5,13 +5,7 @@ its state stays near its reference. When one of them fails, the ride is handed t
 *backup* law that balances the same robot on the same board from the same sensors (the
 pair's PD baseline, :data:`ridempc.controllers.registry.CONTROLLERS`), and handed back
 once the tracking controller has been *fit* again for :data:`RETURN_DWELL_S` (doubled at
-each further handover, :meth:`Handover.dwell`). With ``start_on_backup`` the ride also
-*starts* on the backup and is handed to the tracking controller the first time it has been
-fit for that dwell: its linear model holds only near its reference, and at the start the
-state is off it by the start's offsets and by what the estimators have not yet taken up (a
-payload's centre of mass, which the feet's centre of pressure cannot show while the rider
-sways over them in the start's transient), where the backup's posture feedback needs no
-model:
+each further handover, :meth:`Handover.dwell`):
 
 .. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
           \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
@@ -129,13 +123,9 @@ class Handover:
         standby_every: While the primary rides, the backup runs at every this many ticks
             (1: every tick, as it must with an estimator of its own); half a period after
             the first, off the ticks a primary with a slower loop of its own starts from.
-        start_on_backup: Whether the backup rides from the start until the primary has
-            been fit for ``dwell_s`` (not a handover: not in :attr:`fallbacks`).
 
     Attributes:
         fallbacks: Every handover so far, in order.
-        primary_from_s: When the primary first rode [s]; None while the backup rides the
-            start.
     """
 
     def __init__(
@@ -144,11 +134,8 @@ class Handover:
         blend_s: float = BLEND_S,
         dwell_s: float = RETURN_DWELL_S,
         standby_every: int = 1,
-        start_on_backup: bool = False,
     ) -> None:
         self.backup = backup
-        self._starting = start_on_backup  # the backup rides the start
-        self.primary_from_s: float | None = None if start_on_backup else 0.0
         self.standby_every = standby_every
         self._ticks = 0
         self._backup_command: MotorCommand | None = None
@@ -169,7 +156,7 @@ class Handover:
     @property
     def on_backup(self) -> bool:
         """Whether the backup rides."""
-        return self._starting or (bool(self.fallbacks) and self.fallbacks[-1].duration_s is None)
+        return bool(self.fallbacks) and self.fallbacks[-1].duration_s is None
 
     def step(
         self,
@@ -203,11 +190,8 @@ class Handover:
         if failure is None and primary is not None and fit:
             self._fit_since = now if self._fit_since is None else self._fit_since
             if now - self._fit_since >= self.dwell() - TIME_TOLERANCE:
-                if self._starting:
-                    self._starting, self.primary_from_s = False, now
-                else:
-                    current = self.fallbacks[-1]
-                    current.duration_s = now - current.time_s
+                current = self.fallbacks[-1]
+                current.duration_s = now - current.time_s
                 self._switch(now, self._blended(now, backup))
                 self._last_primary = primary
                 return self._blended(now, primary)

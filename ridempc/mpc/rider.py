@@ -74,10 +74,7 @@ fails, anything raises, the estimate is not finite, or the state strays beyond
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
-each handover is in ``summary()``'s ``fallbacks``. The ride starts on that PD too, handed
-to the MPC once it is fit in the same sense (``summary()``'s ``mpc_from_s``): at the start
-the state is off the MPC's reference by the start's offsets and by a payload the estimate
-has not yet found. Only where the backup too has no
+each handover is in ``summary()``'s ``fallbacks``. Only where the backup too has no
 finite command are the joints held where they are (``safe_hold``).
 """
 
@@ -498,10 +495,7 @@ class MpcRider(Controller):
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
-        # the PD balances the start until the MPC is fit (ridempc.mpc.handover)
-        self.handover = Handover(
-            law, standby_every=STANDBY_DIVIDER if shared else 1, start_on_backup=True
-        )
+        self.handover = Handover(law, standby_every=STANDBY_DIVIDER if shared else 1)
         self._diagnostics: dict[str, float] = {}
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
@@ -1177,7 +1171,6 @@ class MpcRider(Controller):
         out["wbc_elastic_solves"] = self.wbc.qp.elastic_solves
         out["wbc_slack_max"] = self._wbc_slack_max
         out["fallbacks"] = self.handover.summary()
-        out["mpc_from_s"] = self.handover.primary_from_s
         out["safe_hold"] = (
             None
             if self._hold_reason is None
