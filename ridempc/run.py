@@ -35,7 +35,7 @@ from ridempc.sim.levelling import step_levelling
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import RunResult, Simulation
-from ridempc.sim.terrain import lay_out
+from ridempc.sim.terrain import lay_out_under
 from ridempc.units import MAX_DURATION, MIN_DURATION
 
 if TYPE_CHECKING:
@@ -174,15 +174,12 @@ def check_request(request: RideRequest) -> CheckedRide:
     if request.duration is not None:
         scenario = scenario.with_duration(request.duration)
 
-    terrain = None
-    if scenario.terrain:
-        radius = getattr(board.params, "wheel_radius", None) if board is not None else None
-        try:
-            terrain = lay_out(scenario.terrain, radius, board_name)
-        except ConfigError as exc:
-            given = str(request.scenario)
-            path = isinstance(request.scenario, Path) or given.endswith(".toml") or "/" in given
-            raise ConfigError(f"{given if path else f'scenario {scenario.name!r}'}: {exc}") from exc
+    try:
+        terrain = lay_out_under(scenario.terrain, board, board_name)
+    except ConfigError as exc:
+        given = str(request.scenario)
+        path = isinstance(request.scenario, Path) or given.endswith(".toml") or "/" in given
+        raise ConfigError(f"{given if path else f'scenario {scenario.name!r}'}: {exc}") from exc
     scene = build_scene(
         robot,
         request.physics_hz,

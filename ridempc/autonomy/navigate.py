@@ -39,7 +39,7 @@ from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.metrics import run_metrics
 from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
-from ridempc.sim.terrain import lay_out
+from ridempc.sim.terrain import lay_out_under
 
 __all__ = ["NavigateRequest", "map_frame", "navigate"]
 
@@ -152,13 +152,10 @@ def navigate(request: NavigateRequest) -> dict[str, Any]:
         add_obstacles(spec, local.obstacles)
         add_depth_camera(spec, robot.params.base_body, camera)
 
-    terrain = None
-    if local.terrain:
-        radius = getattr(board.params, "wheel_radius", None) if board is not None else None
-        try:
-            terrain = lay_out(local.terrain, radius, board_name)
-        except ConfigError as exc:
-            raise ConfigError(f"{where}: {exc}") from exc
+    try:
+        terrain = lay_out_under(local.terrain, board, board_name)
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from exc
     scene = build_scene(robot, DEFAULT_PHYSICS_HZ, board=board, edit_spec=edit, terrain=terrain)
     origin = scene.data.xpos[scene.base_body, :2].copy()  # the course's start, in the scene
     place_obstacles(scene.model, origin, terrain.level_at if terrain is not None else None)

@@ -22,6 +22,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.board import Board
 from ridempc.errors import ConfigError
 from ridempc.mjcf import STIFF_CONTACT
 from ridempc.scenarios.terrain import (
@@ -281,6 +282,23 @@ def _noise(item: Rough) -> TerrainField:
     peak = float(np.abs(heights).max())
     heights *= item.amplitude / peak if peak > 0.0 else 0.0
     return TerrainField(x=xs, y=ys, heights=heights, level=0.0)
+
+
+def wheel_radius_of(board: Board | None) -> float | None:
+    """The wheel radius of ``board`` [m], in which a step's height may be given; None
+    without a board, or on a board without wheels."""
+    return getattr(board.params, "wheel_radius", None) if board is not None else None
+
+
+def lay_out_under(
+    items: tuple[TerrainItem, ...], board: Board | None, board_name: str
+) -> TerrainLayout | None:
+    """:func:`lay_out` of ``items`` for ``board`` (named ``board_name``), None without items.
+
+    Raises:
+        ConfigError: As :func:`lay_out`.
+    """
+    return lay_out(items, wheel_radius_of(board), board_name) if items else None
 
 
 def lay_out(

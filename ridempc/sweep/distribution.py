@@ -76,6 +76,7 @@ from pydantic import (
 from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.scenarios.scenario import ParameterChange
 from ridempc.sim.knobs import KNOBS, PAYLOAD_OFFSET_MAX
+from ridempc.sim.terrain import wheel_radius_of
 from ridempc.sweep.laws import Law, Quantity, within
 from ridempc.sweep.steering_draws import SteeringDraws
 from ridempc.sweep.terrain_draws import TerrainDraws
@@ -407,8 +408,7 @@ def load_distribution(name_or_path: str, board: str) -> Distribution:
             "board), or no board for a distribution that fits any"
         )
     terrain = distribution.terrain
-    radius = getattr(loaded.params, "wheel_radius", None) if loaded is not None else None
-    why = terrain.step_error(radius, board) if terrain is not None else None
+    why = terrain.step_error(wheel_radius_of(loaded), board) if terrain is not None else None
     if why is not None:
         raise ConfigError(f"{path}: {why}")
     start = distribution.start
