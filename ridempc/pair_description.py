@@ -239,6 +239,14 @@ class PairDescription(_Frozen):
             "The scenario ``ridempc bench`` records: a manoeuvre, where the QPs are hardest."
         ),
     )
+    pd_gains: str | None = Field(
+        default=None,
+        pattern=r"^[a-z0-9][a-z0-9_.-]*\.toml$",
+        description=(
+            "The PD baseline's gains file, in ``ridempc/baselines/``; left out, the "
+            "baseline's default (a quadruped's: the CyberDog2's figures)."
+        ),
+    )
     trajopt: TrajoptSection
     mpc: MpcSection
     wbc: WbcSection
@@ -329,8 +337,8 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
     """Every stage of ``description`` fits its board, and its names exist in the robot.
 
     Raises:
-        ConfigError: A stage needs a board feature the board lacks, or a hip joint or the
-            pusher is not in the robot's description.
+        ConfigError: A stage needs a board feature the board lacks, ``pd_gains`` names no
+            gains file, or a hip joint or the pusher is not in the robot's description.
     """
     from ridempc.boards import load_board
     from ridempc.robots import load_robot
@@ -344,6 +352,7 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
                 f"{shown}: field 'stages.{stage}': needs a board with {lacking[0]}; board "
                 f"'{description.board}' has {', '.join(sorted(features)) or 'none'}"
             )
+    _check_pd_gains(description, shown)
     robot = load_robot(description.robot)
     pusher, sites = description.trajopt.pusher, robot.params.contact_sites
     if pusher is not None and pusher not in sites:
@@ -358,3 +367,15 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
                 f"{shown}: field 'trajopt.hips': '{hip}' is not a motor of "
                 f"{description.robot}; allowed: {', '.join(sorted(joints))}"
             )
+
+
+def _check_pd_gains(description: PairDescription, shown: Path | str) -> None:
+    """Raises ConfigError: ``pd_gains`` names no gains file beside the baselines."""
+    from ridempc.baselines.gains_files import gains_file_names
+
+    named, files = description.pd_gains, gains_file_names()
+    if named is not None and named not in files:
+        raise ConfigError(
+            f"{shown}: field 'pd_gains': '{named}' is not a gains file in ridempc/baselines/; "
+            f"allowed: {', '.join(files)}"
+        )

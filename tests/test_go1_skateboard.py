@@ -26,11 +26,13 @@ def test_the_go1_pair_loads_with_its_library() -> None:
 
 
 def test_each_quadruped_has_its_pd_gains() -> None:
-    """The CyberDog2 keeps the shared file; the Go1's own scales it by its 12.74 kg."""
-    assert gains_file("cyberdog2") == DEFAULT_GAINS_FILE
-    assert gains_file("go1") != DEFAULT_GAINS_FILE
-    dog = load_quadruped_skateboard_gains(gains_file("cyberdog2"))
-    go1 = load_quadruped_skateboard_gains(gains_file("go1"))
+    """The CyberDog2 keeps the shared file; the Go1's pair file names its own, scaled by its
+    12.74 kg; on flat ground, without a pair file, the shared one."""
+    assert gains_file("cyberdog2", "skateboard") == DEFAULT_GAINS_FILE
+    assert gains_file("go1", "skateboard").name == "quadruped_skateboard.go1.toml"
+    assert gains_file("go1", "none") == DEFAULT_GAINS_FILE
+    dog = load_quadruped_skateboard_gains(gains_file("cyberdog2", "skateboard"))
+    go1 = load_quadruped_skateboard_gains(gains_file("go1", "skateboard"))
     assert dog.roll.feedforward == 0.85 and go1.roll.feedforward == 0.79
     assert go1.joints.knee.kp == 100.0  # robots/go1/robot.toml's joint PD
 

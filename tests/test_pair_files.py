@@ -165,6 +165,19 @@ def _edited(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ),
         ("cyberdog2-skateboard", 'pusher = "RL_contact"', "", "needs the pushing foot's"),
         ("cassie-segway", "force_weight = 1000.0", 'force_weight = "1000"', "force_weight"),
+        (
+            "go1-skateboard",
+            'pd_gains = "quadruped_skateboard.go1.toml"',
+            'pd_gains = "quadruped_skateboard.go2.toml"',
+            "field 'pd_gains': 'quadruped_skateboard.go2.toml' is not a gains file in "
+            "ridempc/baselines/; allowed: cassie_hovershoes.toml",
+        ),
+        (
+            "go1-skateboard",
+            'pd_gains = "quadruped_skateboard.go1.toml"',
+            'pd_gains = "../quadruped_skateboard.go1.toml"',
+            "field 'pd_gains': String should match pattern",
+        ),
     ],
 )
 def test_a_bad_pair_file_names_the_file_and_the_field(

@@ -79,7 +79,8 @@ torques, and the VIO's forward speed for steering. Per tick (500 Hz):
    proportion to their normal force.
 
 Motor command per joint: :math:`\\tau = \\tau_{ff} + k_p (q^* - q) + k_d (\\dot q^* - \\dot
-q)`, run by the drivers at the physics rate. Gains: ``quadruped_skateboard.toml``.
+q)`, run by the drivers at the physics rate. Gains: ``quadruped_skateboard.toml``, or the
+file the pair file names (``pd_gains``).
 """
 
 from __future__ import annotations
@@ -205,7 +206,7 @@ class QuadrupedSkateboardPD(Controller):
     Args:
         robot: A quadruped with abad-hip-knee legs.
         board: ``skateboard`` (a board of kind skateboard with its reduced model) or ``none``.
-        gains: Checked gains, or their file; by default the robot's
+        gains: Checked gains, or their file; by default the one the pair file names
             (:func:`~ridempc.baselines.quadruped_skateboard_gains.gains_file`).
 
     Raises:
@@ -223,7 +224,7 @@ class QuadrupedSkateboardPD(Controller):
         self.gains = (
             gains
             if isinstance(gains, QuadrupedSkateboardGains)
-            else load_quadruped_skateboard_gains(gains or gains_file(robot.name))
+            else load_quadruped_skateboard_gains(gains or gains_file(robot.name, board))
         )
         self.rate_hz = self.gains.rate_hz
         self.roll_model = _roll_model(board)

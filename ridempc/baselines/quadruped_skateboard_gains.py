@@ -12,6 +12,7 @@ from typing import Annotated
 
 from pydantic import Field
 
+from ridempc.baselines.gains_files import pair_gains_file
 from ridempc.tomlfile import load_checked
 from ridempc.units import CheckedModel, NonNegative, Positive, Real
 
@@ -165,10 +166,12 @@ def load_quadruped_skateboard_gains(
     return load_checked(Path(path), QuadrupedSkateboardGains, "quadruped skateboard gain file")
 
 
-def gains_file(robot: str) -> Path:
-    """The gains file of the robot named ``robot``: its own,
-    ``quadruped_skateboard.<robot>.toml`` beside the shared one, if it has one (figures that
-    depend on its mass, its stance and its feet), else the shared :data:`DEFAULT_GAINS_FILE`.
+def gains_file(robot: str, board: str) -> Path:
+    """The gains file of ``robot`` on ``board``: the one its pair file names (``pd_gains``:
+    figures that depend on the robot's mass, its stance and its feet), else the shared
+    :data:`DEFAULT_GAINS_FILE`.
+
+    Raises:
+        ConfigError: The pair file is malformed.
     """
-    own = DEFAULT_GAINS_FILE.with_name(f"quadruped_skateboard.{robot}.toml")
-    return own if own.is_file() else DEFAULT_GAINS_FILE
+    return pair_gains_file(robot, board, DEFAULT_GAINS_FILE)
