@@ -501,7 +501,9 @@ def test_slowing_down_brakes_along_a_stop_then_rides_at_the_command() -> None:
 def test_a_commanded_roll_moves_the_reference_to_a_balance(skate_mpc: LinearMpc) -> None:
     """Rolled by 0.05 rad with the static shift, the reference's force-driven accelerations
     are what they were unrolled (to first order); rolled alone they are not."""
-    layout = StateLayout.from_names(skate_mpc.reference.state_names)
+    layout = StateLayout.from_pair(
+        skate_mpc.reference.state_names, load_mpc_pair("cyberdog2", "skateboard")
+    )
     names, roll = layout.names, layout.names["board_roll"]
     t = 6.0
     shift = skate_mpc.static_shift(t, roll, layout.rider_states)
@@ -537,7 +539,7 @@ def test_a_commanded_turn_lays_an_arc_over_the_reference() -> None:
     of mass turns with the heading, and the outer shoe rolls faster by the rate times
     their spacing."""
     mpc = LinearMpc.from_library("cassie", "hovershoes", "accelerate", 1.0)
-    layout = StateLayout.from_names(mpc.reference.state_names)
+    layout = StateLayout.from_pair(mpc.reference.state_names, load_mpc_pair("cassie", "hovershoes"))
     n = layout.names
     problem = mpc.problem(5.0, mpc.reference.sample(5.0, 0, 1.0).states[0])
     steps = problem.state_reference.shape[0] - 1
@@ -582,7 +584,9 @@ def test_a_coasting_rider_slows_the_steady_ride_to_the_board(skate_mpc: LinearMp
     board's speed: half the speed halves the rider's and the board's speeds and the steps
     of their positions from node 0, and leaves the rest (height, roll, joints); at rest
     it stands. Only the pairs without ``stop`` entries coast."""
-    layout = StateLayout.from_names(skate_mpc.reference.state_names)
+    layout = StateLayout.from_pair(
+        skate_mpc.reference.state_names, load_mpc_pair("cyberdog2", "skateboard")
+    )
     n = layout.names
     end = float(skate_mpc.reference.times[-1])
     problem = skate_mpc.problem(end + 1.0, skate_mpc.reference.states[-1])
@@ -621,7 +625,7 @@ def test_swing_targets_follow_the_reference_feet_carried_by_the_board(
     from ridempc.wbc.model import WholeBodyModel
 
     reference = skate_mpc.reference
-    layout = StateLayout.from_names(reference.state_names)
+    layout = StateLayout.from_pair(reference.state_names, load_mpc_pair("cyberdog2", "skateboard"))
     model = WholeBodyModel(load_robot("cyberdog2"))
     feet = ReferenceFeet(model, reference.state_names, layout.base_prefix, layout.board_pose)
     assert feet.plans_feet

@@ -79,12 +79,13 @@ def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push
     forward on the deck) is laid over the reference at the switch and gone by the first
     push; the centre of mass's velocity row carries the blend's rate."""
     from ridempc.mpc.manoeuvre import StateLayout
+    from ridempc.mpc.pairs import load_mpc_pair
     from ridempc.mpc.problem import MpcProblem
     from ridempc.mpc.reference import select_reference
     from ridempc.mpc.switch_blend import SwitchBlend, first_push_time
 
     reference = select_reference("cyberdog2", "skateboard", "accelerate", 0.7)
-    layout = StateLayout.from_names(reference.state_names)
+    layout = StateLayout.from_pair(reference.state_names, load_mpc_pair("cyberdog2", "skateboard"))
     names = layout.names
     push = first_push_time(reference)
     assert 0.5 < push < reference.duration

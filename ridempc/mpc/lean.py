@@ -79,7 +79,7 @@ from numpy.typing import NDArray
 
 from ridempc.baselines.cassie_segway import ShiftLoop
 from ridempc.baselines.cassie_segway_gains import LoopGains
-from ridempc.mpc.manoeuvre import turn_headings
+from ridempc.mpc.manoeuvre import StateLayout, turn_headings
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.state_map import HEADING_SPEED
 from ridempc.mpc.statics import StaticShift
@@ -237,7 +237,7 @@ class LeanSteering:
         states[:, index] = problem.state_reference[:, index] + path
         return replace(problem, state_reference=states, input_reference=inputs)
 
-    def turn(self, problem: MpcProblem, names: dict[str, int]) -> MpcProblem:
+    def turn(self, problem: MpcProblem, layout: StateLayout) -> MpcProblem:
         """Riding, ``problem`` with its reference's headings turned at the followed yaw
         rate from the first node, :math:`\\psi_k \\mathrel{+}= \\omega^* k \\Delta t`, and
         its yaw rates (the base's :math:`\\omega_z`, the board's) raised by it
@@ -247,7 +247,7 @@ class LeanSteering:
         states = problem.state_reference.copy()
         nodes = states.shape[0]
         turned = np.asarray(self.turn_rate * problem.dt * np.arange(nodes), dtype=np.float64)
-        turn_headings(states, names, turned, np.full(nodes, self.turn_rate))
+        turn_headings(states, layout, turned, np.full(nodes, self.turn_rate))
         return replace(problem, state_reference=states)
 
     def drift(self, nx: int, rate: int, speed: float, yaw_rate: float) -> Array | None:

@@ -41,17 +41,22 @@ forces to the balance of that roll (:mod:`ridempc.mpc.statics`).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.canonical import BoardState, board_state_columns
 from ridempc.errors import ConfigError
 from ridempc.library.store import library_folder
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.statics import StaticShift
 from ridempc.scenarios.scenario import Command
+
+if TYPE_CHECKING:  # the pairs build their settings from this module's neighbours
+    from ridempc.mpc.pairs import MpcPair
 
 __all__ = [
     "HOLD",
@@ -59,8 +64,6 @@ __all__ = [
     "REPUSH",
     "REPUSH_BAND",
     "RETARGET_BAND",
-    "HEADING_SUFFIXES",
-    "YAW_RATE_SUFFIXES",
     "Manoeuvre",
     "ManoeuvreSelector",
     "StateLayout",
@@ -79,21 +82,17 @@ REPUSH_BAND: float = 0.2
 # 0 -> 1 m/s ramp over 1 s retargeted 30 times, its reference time jumping between 0 and
 # 1.3 s, and fell).
 RETARGET_BAND: float = 0.25
-# Name endings of a board platform's yaw-rate states (the Hovershoes' and the Segway's).
-YAW_RATE_SUFFIXES: tuple[str, ...] = ("_psi_dot", "_yaw_rate")
-HEADING_SUFFIXES: tuple[str, ...] = ("_yaw", "_psi")  # the base's and the platforms' headings
 
 
-def turn_headings(states: Array, names: dict[str, int], turned: Array, rates: Array) -> None:
+def turn_headings(states: Array, layout: StateLayout, turned: Array, rates: Array) -> None:
     """Turn a reference's headings and yaw rates in place, node by node: every heading (the
-    base's yaw, the platforms' ``*_yaw``, ``*_psi``) gains ``turned`` [rad] and every yaw
-    rate (the base's :math:`\\omega_z`, the platforms' ``*_psi_dot``, ``*_yaw_rate``)
-    gains ``rates`` [rad/s], both (nodes,)."""
-    for name, index in names.items():
-        if name.endswith(HEADING_SUFFIXES):
-            states[:, index] += turned
-        elif name.endswith(YAW_RATE_SUFFIXES) or name == "wz":
-            states[:, index] += rates
+    base's yaw, the platforms' canonical ``heading``) gains ``turned`` [rad] and every yaw
+    rate (the base's :math:`\\omega_z`, the platforms' ``yaw_rate``) gains ``rates``
+    [rad/s], both (nodes,)."""
+    for index in layout.headings:
+        states[:, index] += turned
+    for index in layout.yaw_rates:
+        states[:, index] += rates
 
 
 @dataclass(frozen=True)
@@ -127,42 +126,51 @@ class StateLayout:
     """Where the board and the base sit in a pair's state names.
 
     Attributes:
-        prefixes: Each platform's state prefix, in state order (``board_``, ``left_`` and
-            ``right_``, ``segway_``): the names ending in ``_x`` other than ``com_x``.
-        base_prefix: The base's angle prefix (``trunk_``, ``pelvis_``): the one ``_roll``
-            that is not a platform's.
+        prefixes: Each platform's state prefix, in platform order (``board_``, ``left_`` and
+            ``right_``, ``segway_``), as the board declares them.
+        base_prefix: The base's angle prefix (``trunk_``, ``pelvis_``): its base body's.
         names: Index of each state name.
+        board: Index of each board state, by its platform and canonical quantity
+            (:mod:`ridempc.boards.canonical`).
     """
 
     prefixes: tuple[str, ...]
     base_prefix: str
     names: dict[str, int]
+    board: Mapping[BoardState, int]
 
     @classmethod
-    def from_names(cls, state_names: Sequence[str]) -> StateLayout:
-        """Raises ConfigError: the names do not tell the base's roll."""
+    def from_pair(cls, state_names: Sequence[str], pair: MpcPair) -> StateLayout:
+        """The layout a pair declares: its platforms' prefixes (``MpcPair.platform_prefixes``),
+        its board states' quantities (``MpcPair.board_states``) and its robot's base body
+        (``MpcPair.base``, whose angles are ``<base>_roll`` ...).
+
+        Raises ConfigError: the names have no ``<base>_roll`` or no platform's ``x``."""
         names = list(state_names)
-        prefixes = tuple(n[: -len("x")] for n in names if n.endswith("_x") and n != "com_x")
-        bases = [
-            n[: -len("roll")] for n in names if n.endswith("_roll") and not n.startswith(prefixes)
+        board = board_state_columns(names, pair.board_states)
+        prefixes, base = tuple(pair.platform_prefixes), pair.base
+        missing = [n for n in (f"{base}_roll", f"{base}_yaw", "wz") if n not in names] + [
+            f"{p}x" for k, p in enumerate(prefixes) if BoardState(k, "x") not in board
         ]
-        if len(bases) != 1:
-            raise ConfigError(f"cannot tell the base's roll among the states {names}")
-        return cls(prefixes, bases[0], {n: i for i, n in enumerate(names)})
-
-    @classmethod
-    def from_pair(
-        cls, state_names: Sequence[str], prefixes: Sequence[str], base: str
-    ) -> StateLayout:
-        """The layout a pair declares: its platforms' prefixes (``MpcPair.platform_prefixes``)
-        and its robot's base body (``MpcPair.base``, whose angles are ``<base>_roll`` ...).
-
-        Raises ConfigError: the names have no ``<base>_roll`` or no ``<prefix>x``."""
-        names = list(state_names)
-        missing = [n for n in (f"{base}_roll", *(f"{p}x" for p in prefixes)) if n not in names]
         if missing:
             raise ConfigError(f"no state '{missing[0]}' among the states {names}")
-        return cls(tuple(prefixes), f"{base}_", {n: i for i, n in enumerate(names)})
+        return cls(prefixes, f"{base}_", {n: i for i, n in enumerate(names)}, board)
+
+    def column(self, prefix: str, quantity: str) -> int | None:
+        """The index of a platform's state of a canonical ``quantity``, or None."""
+        return self.board.get(BoardState(self.prefixes.index(prefix), quantity))
+
+    @property
+    def headings(self) -> tuple[int, ...]:
+        """Indices of the headings: the base's yaw and each platform's ``heading``."""
+        platforms = (self.column(p, "heading") for p in self.prefixes)
+        return (self.names[f"{self.base_prefix}yaw"], *(i for i in platforms if i is not None))
+
+    @property
+    def yaw_rates(self) -> tuple[int, ...]:
+        """Indices of the yaw rates: the base's :math:`\\omega_z` and each platform's."""
+        platforms = (self.column(p, "yaw_rate") for p in self.prefixes)
+        return (self.names["wz"], *(i for i in platforms if i is not None))
 
     @property
     def rider_states(self) -> tuple[int, ...]:
@@ -170,20 +178,24 @@ class StateLayout:
         return tuple(i for n, i in self.names.items() if not n.startswith(self.prefixes))
 
     def heading(self, prefix: str) -> int | None:
-        """The index of a platform's heading state (``<prefix>yaw`` or ``<prefix>psi``)."""
-        return self.names.get(f"{prefix}yaw", self.names.get(f"{prefix}psi"))
+        """The index of a platform's heading state (canonical ``heading``)."""
+        return self.column(prefix, "heading")
 
     def speed(self, prefix: str) -> int | None:
-        """The index of a platform's speed state (``<prefix>v`` or ``<prefix>speed``)."""
-        return self.names.get(f"{prefix}v", self.names.get(f"{prefix}speed"))
+        """The index of a platform's speed state (canonical ``speed``)."""
+        return self.column(prefix, "speed")
+
+    def position(self, prefix: str) -> list[int]:
+        """The indices of a platform's origin, its canonical ``x`` and ``y``."""
+        return [self.board[BoardState(self.prefixes.index(prefix), axis)] for axis in "xy"]
 
     def board_pose(self, state: Array) -> tuple[float, float, float]:
         """The first platform's (x, y, heading) in a state."""
-        prefix, names = self.prefixes[0], self.names
+        prefix = self.prefixes[0]
         heading = self.heading(prefix)
         if heading is None:
             raise ConfigError(f"no heading state for platform '{prefix}'")
-        x, y = state[names[f"{prefix}x"]], state[names[f"{prefix}y"]]
+        x, y = state[self.position(prefix)]
         return float(x), float(y), float(state[heading])
 
 
@@ -324,14 +336,16 @@ class ManoeuvreSelector:
         """
         names = layout.names
         states = problem.state_reference.copy()
-        reference = float(states[0, names[f"{layout.prefixes[0]}v"]])
+        speeds = [layout.speed(p) for p in layout.prefixes]
+        if speeds[0] is None:
+            raise ConfigError(f"no speed state for platform '{layout.prefixes[0]}'")
+        reference = float(states[0, speeds[0]])
         ratio = max(speed, 0.0) / reference if reference > MOVING else 0.0
-        for prefix in ("com_", *layout.prefixes):
-            for axis in ("x", "y"):
-                i = names[f"{prefix}{axis}"]
-                states[:, i] = states[0, i] + ratio * (states[:, i] - states[0, i])
-        for name in ("vx", "vy", *(f"{p}v" for p in layout.prefixes)):
-            states[:, names[name]] *= ratio
+        platforms = [i for p in layout.prefixes for i in layout.position(p)]
+        for i in (names["com_x"], names["com_y"], *platforms):
+            states[:, i] = states[0, i] + ratio * (states[:, i] - states[0, i])
+        for i in (names["vx"], names["vy"], *(i for i in speeds if i is not None)):
+            states[:, i] *= ratio
         return replace(problem, state_reference=states)
 
     @staticmethod
@@ -376,13 +390,13 @@ class ManoeuvreSelector:
             return np.column_stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]])
 
         com = [names["com_x"], names["com_y"]]
-        pivot = states[0, [names[f"{layout.prefixes[0]}x"], names[f"{layout.prefixes[0]}y"]]]
+        pivot = states[0, layout.position(layout.prefixes[0])]
         centre = states[:, com]
         start = pivot + turn(centre[:1] - pivot)[0]
         steps = turn(np.diff(centre, axis=0))
         turned_centre = start + np.vstack([np.zeros(2), np.cumsum(steps, axis=0)])
         for prefix in layout.prefixes:
-            columns = [names[f"{prefix}x"], names[f"{prefix}y"]]
+            columns = layout.position(prefix)
             offset = states[:, columns] - centre
             index = layout.heading(prefix)
             heading = np.zeros(len(states)) if index is None else states[:, index]
@@ -394,7 +408,7 @@ class ManoeuvreSelector:
         states[:, com] = turned_centre
         velocity = [names["vx"], names["vy"]]
         states[:, velocity] = turn(states[:, velocity])
-        turn_headings(states, names, turned_k, step_rates)
+        turn_headings(states, layout, turned_k, step_rates)
         return replace(problem, state_reference=states)
 
     @staticmethod

@@ -115,7 +115,6 @@ from ridempc.mpc.handover import (
 from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
-    HEADING_SUFFIXES,
     HOLD,
     REPUSH,
     Manoeuvre,
@@ -373,11 +372,9 @@ class MpcRider(Controller):
         self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
-        self.layout = StateLayout.from_pair(
-            reference.state_names, self.pair.platform_prefixes, self.pair.base
-        )
+        self.layout = StateLayout.from_pair(reference.state_names, self.pair)
         self.map = StateMap(
-            self.pinocchio, reference.state_names, self.layout.prefixes, base=self.pair.base
+            self.pinocchio, reference.state_names, self.pair.board_states, base=self.pair.base
         )
         # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
         # the estimator's spring deflection (about twice the true one, through the soft
@@ -789,7 +786,7 @@ class MpcRider(Controller):
             if lean.offset != 0.0:
                 balance = self._lean_balance(t_ref, inputs.manoeuvre)
                 problem = lean.lean(problem, names["com_y"], names["vy"], balance)
-            problem = lean.turn(problem, names)
+            problem = lean.turn(problem, self.layout)
         if inputs.shoes is not None:  # each shoe's heading turned towards its line, its
             columns = self._shoe_columns  # feet's place along it and its drag
             states = spread_lines(problem.state_reference, columns, inputs.lateral_offset)
@@ -942,14 +939,13 @@ class MpcRider(Controller):
         return np.clip(roll, low, high)
 
     def _unwrapped(self, x0: Array, reference: Array) -> Array:
-        """``x0`` with each heading (``*_yaw``, ``*_psi``) [rad] within :math:`\\pi` of the
-        ``reference`` state's turned by the turn so far: the estimate's angles wrap at
-        :math:`\\pm\\pi`, the commanded turn does not."""
+        """``x0`` with each heading (the base's yaw, the platforms') [rad] within
+        :math:`\\pi` of the ``reference`` state's turned by the turn so far: the estimate's
+        angles wrap at :math:`\\pm\\pi`, the commanded turn does not."""
         out = x0.copy()
-        for name, i in self.layout.names.items():
-            if name.endswith(HEADING_SUFFIXES):
-                target = reference[i] + self._turned
-                out[i] = target + math.remainder(x0[i] - target, 2.0 * math.pi)
+        for i in self.layout.headings:
+            target = reference[i] + self._turned
+            out[i] = target + math.remainder(x0[i] - target, 2.0 * math.pi)
         return out
 
     def _coasting(self, t_ref: float) -> bool:

@@ -10,13 +10,14 @@ The MPC's state (the library's layout, named by ``state_names``) is built from t
   base orientation, :math:`R = R_z(\\psi) R_y(\\vartheta) R_x(\\phi)`;
 - ``wx, wy, wz`` [rad/s]: the base angular velocity in the base frame;
 - ``q_<joint>`` [rad]: the encoders (through the estimator);
-- board states, by the suffix of their names, from the platform estimates of the rider's
-  feet (:class:`~ridempc.estimation.BoardEstimate`), one per platform in the order of
-  ``platform_prefixes``: ``x``, ``y`` [m] its origin, ``psi``/``yaw`` [rad] heading,
-  ``theta`` [rad] pitch (nose down positive), ``roll`` [rad], ``v``/``speed`` [m/s] forward
-  speed :math:`\\dot c \\cdot (\\cos\\psi, \\sin\\psi)`, and the rates ``theta_dot``,
-  ``theta_rate``, ``roll_rate``, ``psi_dot``, ``yaw_rate`` [rad/s], differentiated from the
-  angles through a first-order low-pass (``RATE_FILTER_HZ``).
+- board states, by their canonical quantity (:mod:`ridempc.boards.canonical`, the board's
+  ``board_states``), from the platform estimates of the rider's feet
+  (:class:`~ridempc.estimation.BoardEstimate`), one per platform in the board's platform
+  order: ``x``, ``y`` [m] its origin, ``heading`` [rad], ``pitch`` [rad] (nose down
+  positive), ``roll`` [rad], ``speed`` [m/s] forward speed
+  :math:`\\dot c \\cdot (\\cos\\psi, \\sin\\psi)`, and the rates ``pitch_rate``,
+  ``roll_rate``, ``yaw_rate`` [rad/s], differentiated from the angles through a first-order
+  low-pass (``RATE_FILTER_HZ``).
 
 **Library frame.** The library's trajectories start at the origin, heading along x. The map
 keeps a planar transform :math:`(\\Delta\\psi, \\Delta p)` from the world to that frame,
@@ -31,13 +32,14 @@ rates, not a path).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from ridempc.boards.canonical import BoardState
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState
 from ridempc.estimation.state import BoardEstimate
@@ -166,8 +168,8 @@ class StateMap:
     Args:
         robot: The rider's Pinocchio model.
         state_names: The pair's state layout.
-        platform_prefixes: The board-state prefix of each platform estimate, estimator
-            order (``("board_",)``, ``("left_", "right_")``, ``("segway_",)``).
+        board_states: Per board state name, its platform (estimator order) and canonical
+            quantity (:attr:`~ridempc.mpc.pairs.MpcPair.board_states`).
         base: The robot's base body (its description's ``base_body``): the states
             ``<base>_roll``, ``<base>_pitch``, ``<base>_yaw`` are its Z-Y-X angles.
 
@@ -179,7 +181,7 @@ class StateMap:
         self,
         robot: PinocchioRobot,
         state_names: Sequence[str],
-        platform_prefixes: Sequence[str],
+        board_states: Mapping[str, BoardState],
         *,
         base: str,
     ) -> None:
@@ -187,7 +189,7 @@ class StateMap:
         self.base = base  # the base body, whose angles are ``<base>_roll`` ...
         self.data = robot.model.createData()
         self.names = tuple(state_names)
-        self.prefixes = tuple(platform_prefixes)
+        self.board_states = board_states
         self.frame = PlanarFrame()
         self._rates: dict[str, _AngleRate] = {}
         self._heading_time = 0.0
@@ -211,9 +213,9 @@ class StateMap:
                 return ("base_angle", k)
         if name.startswith("q_"):
             return ("joint", name[2:])
-        for k, prefix in enumerate(self.prefixes):
-            if name.startswith(prefix):
-                return ("board", f"{k}:{name[len(prefix) :]}")
+        if name in self.board_states:
+            platform, quantity = self.board_states[name]
+            return ("board", f"{platform}:{quantity}")
         raise ConfigError(f"MPC state map: cannot estimate state '{name}'")
 
     def reset(self) -> None:
@@ -229,7 +231,7 @@ class StateMap:
     def _board_value(
         self, key: str, boards: tuple[BoardEstimate, ...], time: float, origins: dict[int, Array]
     ) -> float:
-        """One board state of ``key`` (``platform:field``); ``origins`` holds each
+        """One board state of ``key`` (``platform:quantity``); ``origins`` holds each
         platform's position in the library frame once found (one per :meth:`state`)."""
         index, field = key.split(":", 1)
         k = int(index)
@@ -244,21 +246,15 @@ class StateMap:
             return float(origin[0])
         if field == "y":
             return float(origin[1])
-        if field in ("psi", "yaw"):
+        if field == "heading":
             return heading
-        if field == "theta":
+        if field == "pitch":
             return board.pitch
         if field == "roll":
             return board.roll
-        if field in ("v", "speed"):
+        if field == "speed":
             return forward_speed(board)
-        angle = {
-            "theta_dot": board.pitch,
-            "theta_rate": board.pitch,
-            "roll_rate": board.roll,
-            "psi_dot": board.yaw,
-            "yaw_rate": board.yaw,
-        }
+        angle = {"pitch_rate": board.pitch, "roll_rate": board.roll, "yaw_rate": board.yaw}
         if field in angle:
             rate = self._rates.setdefault(key, _AngleRate(RATE_FILTER_HZ))
             return rate(time, angle[field])
