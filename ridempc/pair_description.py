@@ -239,6 +239,14 @@ class PairDescription(_Frozen):
             "The scenario ``ridempc bench`` records: a manoeuvre, where the QPs are hardest."
         ),
     )
+    ride_keyframe: str | None = Field(
+        default=None,
+        pattern=r"^[A-Za-z0-9_.-]+$",
+        description=(
+            "The keyframe of the robot's description the MPC rider rides in, where it is "
+            "not its stance on the board (Cassie crouches on the Segway to reach the knee bar)."
+        ),
+    )
     pd_gains: str | None = Field(
         default=None,
         pattern=r"^[a-z0-9][a-z0-9_.-]*\.toml$",
@@ -338,7 +346,8 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
 
     Raises:
         ConfigError: A stage needs a board feature the board lacks, ``pd_gains`` names no
-            gains file, or a hip joint or the pusher is not in the robot's description.
+            gains file, or a hip joint, the pusher or the ride keyframe is not in the robot's
+            description.
     """
     from ridempc.boards import load_board
     from ridempc.robots import load_robot
@@ -354,6 +363,13 @@ def check_pair_fits(description: PairDescription, shown: Path | str) -> None:
             )
     _check_pd_gains(description, shown)
     robot = load_robot(description.robot)
+    model = robot.mj_model
+    keyframes = [model.key(i).name for i in range(model.nkey)]
+    if description.ride_keyframe is not None and description.ride_keyframe not in keyframes:
+        raise ConfigError(
+            f"{shown}: field 'ride_keyframe': '{description.ride_keyframe}' is not a keyframe "
+            f"of {description.robot}; allowed: {', '.join(keyframes)}"
+        )
     pusher, sites = description.trajopt.pusher, robot.params.contact_sites
     if pusher is not None and pusher not in sites:
         raise ConfigError(

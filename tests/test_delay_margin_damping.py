@@ -11,6 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from ridempc.mpc.riding_posture import ride_qpos
 from ridempc.robots import load_robot
 from ridempc.robots.delay_margin import (
     best_damping,
@@ -47,7 +48,7 @@ def test_the_knee_in_the_segway_crouch_gains_its_margin_from_the_damping() -> No
 
 def test_the_riders_delayed_motors_get_the_best_damping_the_others_keep_theirs() -> None:
     cassie = load_robot("cassie")
-    qpos = cassie.ride_qpos("segway")
+    qpos = ride_qpos(cassie, "segway")
     kp = 0.1 * np.array([m.kp for m in cassie.motors])
     kd = 0.1 * np.array([m.kd for m in cassie.motors])
     damped = tracking_damping(cassie.mj_model, qpos, cassie.motors, kp, kd, STEP)

@@ -18,6 +18,7 @@ from ridempc.mpc.lean import (
     com_height,
 )
 from ridempc.mpc.rider import MpcRider
+from ridempc.mpc.riding_posture import ride_qpos
 from ridempc.mpc.statics import StaticShift
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -48,12 +49,12 @@ def test_the_riding_keyframe_crouches_cassie_by_a_quarter_metre(cassie) -> None:
     """The Segway's riding keyframe stands on its soles with the centre of mass 0.617 m
     over them (the pd rider's crouch), 0.255 m under the stance's; elsewhere the rider
     rides in its stance."""
-    ride = cassie.ride_qpos("segway")
+    ride = ride_qpos(cassie, "segway")
     assert com_height(cassie, ride) == pytest.approx(0.617, abs=0.005)
     crouch = Crouch.of(cassie, "segway")
     assert crouch is not None and crouch.drop == pytest.approx(-0.255, abs=0.005)
     assert Crouch.of(cassie, "hovershoes") is None
-    np.testing.assert_array_equal(cassie.ride_qpos("hovershoes"), cassie.stance_qpos("hovershoes"))
+    np.testing.assert_array_equal(ride_qpos(cassie, "hovershoes"), cassie.stance_qpos("hovershoes"))
 
 
 def test_the_crouch_comes_in_over_its_ramp(segway_rider, problem) -> None:
@@ -102,7 +103,7 @@ def test_standing_the_lean_grows_against_the_turn_and_moves_the_balance_along(
     np.testing.assert_allclose(moved.state_reference[:, other], states[:, other] + 0.5 * bound)
     np.testing.assert_allclose(moved.state_reference[:, rate], states[:, rate])
     np.testing.assert_allclose(moved.input_reference, inputs + 100.0 * bound)
-    assert steering.turn(problem, names) is problem  # standing: no turn laid on
+    assert steering.turn(problem, segway_rider.layout) is problem  # standing: no turn laid on
     assert steering.drift(nx, rate, 0.2, 0.3) is None
     still = LeanSteering()  # standing still, nothing turning: nothing leans
     assert still.update(0.1, 0.5, 0.0, slow) == 0.0
@@ -148,7 +149,7 @@ def test_riding_the_turn_is_laid_on_the_yaw_references_and_its_pull_on_the_rates
     steering = LeanSteering()
     names = segway_rider.layout.names
     steering.update(0.0, 0.5, 0.0, 1.0)
-    turned = steering.turn(problem, names)
+    turned = steering.turn(problem, segway_rider.layout)
     before, after = problem.state_reference, turned.state_reference
     k = np.arange(before.shape[0])
     headings = [names["pelvis_yaw"], names["segway_psi"]]
@@ -164,7 +165,7 @@ def test_riding_the_turn_is_laid_on_the_yaw_references_and_its_pull_on_the_rates
     np.testing.assert_allclose(drift, -0.8 * np.eye(nx)[names["vy"]])
     straight = LeanSteering()
     straight.update(0.0, 0.0, 0.0, 1.0)
-    assert straight.turn(problem, names) is problem
+    assert straight.turn(problem, segway_rider.layout) is problem
 
 
 def test_on_the_segway_cassie_crouches_and_turns_by_the_knee_bar(cassie, tmp_path) -> None:
@@ -173,7 +174,7 @@ def test_on_the_segway_cassie_crouches_and_turns_by_the_knee_bar(cassie, tmp_pat
     rider = MpcRider(cassie, "segway")  # its own: the ride changes the lean loop
     assert rider.lean is not None and MpcRider(cassie, "hovershoes").lean is None
     np.testing.assert_allclose(
-        rider.wbc.posture, motor_posture(rider.pinocchio, cassie, cassie.ride_qpos("segway"))
+        rider.wbc.posture, motor_posture(rider.pinocchio, cassie, ride_qpos(cassie, "segway"))
     )
     toml = tmp_path / "turn.toml"
     toml.write_text(

@@ -166,6 +166,12 @@ def _edited(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ("cyberdog2-skateboard", 'pusher = "RL_contact"', "", "needs the pushing foot's"),
         ("cassie-segway", "force_weight = 1000.0", 'force_weight = "1000"', "force_weight"),
         (
+            "cassie-segway",
+            'ride_keyframe = "ride_segway_crouch"',
+            'ride_keyframe = "crouch"',
+            "field 'ride_keyframe': 'crouch' is not a keyframe of cassie; allowed: ",
+        ),
+        (
             "go1-skateboard",
             'pd_gains = "quadruped_skateboard.go1.toml"',
             'pd_gains = "quadruped_skateboard.go2.toml"',

@@ -9,7 +9,7 @@ gives, so the rider holds that input at zero and leans instead, as the ``pd`` ba
 (:mod:`ridempc.baselines.cassie_segway`) does:
 
 1. **Crouch** (:class:`Crouch`). Standing tall, Cassie's shins pass 0.13-0.24 m behind the
-   pad. The rider rides in the robot's riding keyframe (``ride_keyframes``): its whole-body
+   pad. The rider rides in the pair's riding keyframe (``ride_keyframe``): its whole-body
    posture task holds that keyframe's motor angles, and the MPC's centre-of-mass height
    reference is lowered by
 
@@ -81,6 +81,7 @@ from ridempc.baselines.cassie_segway import ShiftLoop
 from ridempc.baselines.cassie_segway_gains import LoopGains
 from ridempc.mpc.manoeuvre import StateLayout, turn_headings
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.riding_posture import ride_keyframe, ride_qpos
 from ridempc.mpc.state_map import HEADING_SPEED
 from ridempc.mpc.statics import StaticShift
 from ridempc.robots.robot import Robot
@@ -144,9 +145,9 @@ class Crouch:
     def of(cls, robot: Robot, board: str) -> Crouch | None:
         """The crouch from the robot's stance on ``board`` to its riding keyframe, or None
         when it rides in its stance."""
-        if board not in robot.params.ride_keyframes:
+        if ride_keyframe(robot, board) is None:
             return None
-        drop = com_height(robot, robot.ride_qpos(board)) - com_height(
+        drop = com_height(robot, ride_qpos(robot, board)) - com_height(
             robot, robot.stance_qpos(board)
         )
         return cls(drop)

@@ -127,6 +127,7 @@ from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.reference import MotionReference
+from ridempc.mpc.riding_posture import ride_qpos
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
@@ -393,7 +394,7 @@ class MpcRider(Controller):
             robot,
             settings_wbc,
             pinocchio=self.pinocchio,
-            posture=motor_posture(self.pinocchio, robot, robot.ride_qpos(board)),
+            posture=motor_posture(self.pinocchio, robot, ride_qpos(robot, board)),
             platforms=rolling_platforms(loaded),
         )
         self._feedforward = tuning.feedforward
@@ -403,7 +404,7 @@ class MpcRider(Controller):
         self.kp = scale * np.array([m.kp for m in robot.motors])
         self.kd = tracking_damping(  # each delayed loop damped at its largest margin
             robot.mj_model,
-            robot.ride_qpos(board),
+            ride_qpos(robot, board),
             robot.motors,
             self.kp,
             scale * np.array([m.kd for m in robot.motors]),

@@ -83,13 +83,6 @@ class RobotParameters(_Frozen):
         default_factory=dict,
         description="Per board name, the keyframe to start from on that board (else the stand).",
     )
-    ride_keyframes: dict[str, str] = Field(
-        default_factory=dict,
-        description=(
-            "Per board name, the keyframe of the posture the MPC rider rides in, where it "
-            "is not the stance (Cassie crouches on the Segway to reach the knee bar)."
-        ),
-    )
     fall_height: PositiveFloat = Field(
         le=3.0,  # no legged robot's base stands 3 m high
         description="Base origin below this height over its support = fall [m].",

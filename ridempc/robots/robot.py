@@ -134,12 +134,6 @@ class Robot:
             self.params.stance_keyframes.get(board, self.params.stand_keyframe)
         )
 
-    def ride_qpos(self, board: str) -> NDArray[np.float64]:
-        """The configuration the MPC rider rides in on ``board`` (the stance unless a riding
-        posture is given)."""
-        name = self.params.ride_keyframes.get(board)
-        return self.stance_qpos(board) if name is None else self.keyframe_qpos(name)
-
     def keyframe_qpos(self, name: str) -> NDArray[np.float64]:
         """A keyframe of the description [MuJoCo qpos]."""
         model = self.mj_model
