@@ -127,6 +127,7 @@ from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
@@ -341,6 +342,10 @@ class MpcRider(Controller):
         )
         self.pinocchio = build_pinocchio_robot(robot)
         self.selector = ManoeuvreSelector(robot.name, board)
+        symmetry = self.pair.symmetry  # each re-push from the side its turn needs
+        self.push_side = (
+            PushSide(symmetry) if symmetry is not None and REPUSH in self.selector.targets else None
+        )
         first = self.selector.initial()
         self.mpc = LinearMpc.from_library(
             robot.name, board, first.library_kind, first.target, settings
@@ -640,6 +645,12 @@ class MpcRider(Controller):
         began = wanted is not self.manoeuvre
         if began:
             self.mpc.retarget(wanted.library_kind, wanted.target)
+            if wanted.kind == REPUSH and self.push_side is not None:
+                self.mpc.reference = self.push_side.reference(
+                    self.mpc.reference,
+                    self._yaw_rate_ahead(command, now, first_stride(self.mpc.reference)),
+                    self.pair.board_states,
+                )
             reference = self.mpc.reference
             start = self.selector.phase_start(
                 reference.times,
@@ -1061,6 +1072,14 @@ class MpcRider(Controller):
         if planned is not None:
             return planned
         return np.full(settings.horizon, float(command.yaw_rate))
+
+    def _yaw_rate_ahead(self, command: Command, now: float, window: tuple[float, float]) -> float:
+        """The commanded yaw rate [rad/s] averaged over ``window`` [s] from ``now`` where
+        the ride's commands are planned, else the present one."""
+        dt = self.mpc.settings.dt
+        times = now + window[0] + dt * np.arange(max(1, round((window[1] - window[0]) / dt)))
+        planned = self._planned("yaw_rate", times)
+        return float(np.mean(planned)) if planned is not None else float(command.yaw_rate)
 
     def _speed_preview_s(self) -> float:
         """How far ahead the manoeuvre reads a planned speed [s]: the MPC's horizon where the
