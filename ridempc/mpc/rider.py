@@ -127,6 +127,7 @@ from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.push_gain import shifted_speeds
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.roll_observer import RollObserver
@@ -783,6 +784,8 @@ class MpcRider(Controller):
         # slows more than its model, had the MPC push the body forward and brake the deck.
         if inputs.coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
+        elif inputs.manoeuvre[0] == REPUSH:  # from the first push: the planned gain
+            problem = shifted_speeds(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, inputs.roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
