@@ -1077,10 +1077,13 @@ class MpcRider(Controller):
         return np.full(settings.horizon, float(command.yaw_rate))
 
     def _yaw_rate_ahead(self, command: Command, now: float, window: tuple[float, float]) -> float:
-        """The commanded yaw rate [rad/s] averaged over ``window`` [s] from ``now`` where
-        the ride's commands are planned, else the present one."""
+        """The commanded yaw rate [rad/s] averaged over ``window`` [s] from ``now``: as a
+        path follower expects to ask it (``turn_preview``), else where the ride's commands
+        are planned, else the present one."""
         dt = self.mpc.settings.dt
         times = now + window[0] + dt * np.arange(max(1, round((window[1] - window[0]) / dt)))
+        if self.turn_preview is not None:
+            return float(np.mean([self.turn_preview(float(t)) for t in times]))
         planned = self._planned("yaw_rate", times)
         return float(np.mean(planned)) if planned is not None else float(command.yaw_rate)
 
