@@ -170,3 +170,28 @@ def test_a_ride_with_a_path_follows_it_and_reports_the_cross_track() -> None:
     assert summary["status"] == "ok"
     assert summary["cross_track_rmse"] < 0.02  # [m] standing on its start
     assert "gates" not in summary
+
+
+def test_the_rider_is_told_the_turn_ahead_of_it() -> None:
+    """On the circle's straight entry the law asks for no turn yet, but the rider it wraps is
+    told (``turn_preview``) the path's turn once she reaches the circle at her speed."""
+    from types import SimpleNamespace
+
+    from ridempc.controllers.base import Controller
+    from ridempc.controllers.path_following import PathFollowing
+
+    class Still(Controller):
+        def update(self, sensors, command):  # type: ignore[no-untyped-def, override]
+            raise AssertionError("not ridden")
+
+    inner = Still(None, "none")  # type: ignore[arg-type]  # no robot: never ridden
+    follower = PathFollowing(inner, CIRCLE)
+    assert inner.turn_preview == follower.turn_ahead
+    vio = SimpleNamespace(
+        stamp=1.0, position=(0.0, 0.0), velocity=(0.5, 0.0), yaw=0.0, yaw_rate=0.0
+    )
+    now = follower.yaw_rate(SimpleNamespace(time=1.0, vio=vio))  # type: ignore[arg-type]
+    follower._yaw_rate = now
+    assert now == pytest.approx(0.0, abs=1e-6)  # 2 m before the circle, on the line
+    assert follower.turn_ahead(2.0) == pytest.approx(0.0, abs=1e-6)  # 0.5 m on: the line
+    assert follower.turn_ahead(6.0) == pytest.approx(0.5 / 3.0, rel=0.05)  # on the circle

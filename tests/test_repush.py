@@ -8,6 +8,7 @@ import pytest
 
 from ridempc.errors import ConfigError
 from ridempc.mpc.manoeuvre import REPUSH, REPUSH_BAND, Manoeuvre, ManoeuvreSelector
+from ridempc.mpc.problem import MpcProblem
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.pairs import EntrySpec, load_pair
 from ridempc.trajopt.schedule import push_schedule
@@ -74,28 +75,10 @@ def test_the_rider_pushes_again_once_the_board_has_slowed() -> None:
     assert ManoeuvreSelector.phase_start(times, speeds, 0.52, 9.0, REPUSH) == 9.0
 
 
-def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push() -> None:
-    """The offset between the rider and the re-push's first knot (the body 3 cm further
-    forward on the deck) is laid over the reference at the switch and gone by the first
-    push; the centre of mass's velocity row carries the blend's rate."""
-    from ridempc.mpc.manoeuvre import StateLayout
-    from ridempc.mpc.pairs import load_mpc_pair
-    from ridempc.mpc.problem import MpcProblem
-    from ridempc.mpc.reference import select_reference
-    from ridempc.mpc.switch_blend import SwitchBlend, first_push_time
-
-    reference = select_reference("cyberdog2", "skateboard", "accelerate", 0.7)
-    layout = StateLayout.from_pair(reference.state_names, load_mpc_pair("cyberdog2", "skateboard"))
-    names = layout.names
-    push = first_push_time(reference)
-    assert 0.5 < push < reference.duration
-    x0 = reference.states_at(np.array([0.0]))[0].copy()
-    x0[names["com_x"]] += 0.05  # 3 cm ahead of the knot on a deck 2 cm further on
-    x0[names["board_x"]] += 0.02
-    x0[names["q_FL_knee"]] += 0.1
-    n, nx, nu, dt = 40, len(x0), 2, 0.05
-    window = reference.states_at(dt * np.arange(n + 1))
-    problem = MpcProblem(
+def _problem(x0: np.ndarray, window: np.ndarray, dt: float) -> MpcProblem:
+    """An MPC problem around the state reference ``window`` (its dynamics unused)."""
+    n, nx, nu = len(window) - 1, len(x0), 2
+    return MpcProblem(
         initial_state=x0,
         A=np.tile(np.eye(nx), (n, 1, 1)),
         B=np.zeros((n, nx, nu)),
@@ -111,6 +94,29 @@ def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push
         constraint_upper=np.zeros((n, 0)),
         dt=dt,
     )
+
+
+def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push() -> None:
+    """The offset between the rider and the re-push's first knot (the body 3 cm further
+    forward on the deck) is laid over the reference at the switch and gone by the first
+    push; the centre of mass's velocity row carries the blend's rate."""
+    from ridempc.mpc.manoeuvre import StateLayout
+    from ridempc.mpc.pairs import load_mpc_pair
+    from ridempc.mpc.reference import select_reference
+    from ridempc.mpc.switch_blend import SwitchBlend, first_push_time
+
+    reference = select_reference("cyberdog2", "skateboard", "accelerate", 0.7)
+    layout = StateLayout.from_pair(reference.state_names, load_mpc_pair("cyberdog2", "skateboard"))
+    names = layout.names
+    push = first_push_time(reference)
+    assert 0.5 < push < reference.duration
+    x0 = reference.states_at(np.array([0.0]))[0].copy()
+    x0[names["com_x"]] += 0.05  # 3 cm ahead of the knot on a deck 2 cm further on
+    x0[names["board_x"]] += 0.02
+    x0[names["q_FL_knee"]] += 0.1
+    n, dt = 40, 0.05
+    window = reference.states_at(dt * np.arange(n + 1))
+    problem = _problem(x0, window, dt)
     blend = SwitchBlend.at_switch(problem, reference, layout, 0.0)
     assert blend.offsets[names["com_x"]] == pytest.approx(0.03)
     assert blend.offsets[names["board_x"]] == 0.0
@@ -157,3 +163,36 @@ def test_holding_the_speed_is_refused_where_the_library_cannot_push_again() -> N
     check_hold(held, None, "skateboard")  # a dead weight holds nothing
     with pytest.raises(ConfigError, match=r"field 'push_off.hold' is true; allowed: .*repush"):
         check_hold(held, "cassie", "hovershoes")
+
+
+def test_a_repush_after_its_first_push_gains_its_planned_speed_from_the_board() -> None:
+    """The reference's forward speeds shifted by the board's deficit at node 0, the gain over
+    the horizon kept, and the places moved by the same speed integrated."""
+    from ridempc.mpc.manoeuvre import StateLayout
+    from ridempc.mpc.pairs import load_mpc_pair
+    from ridempc.mpc.push_gain import shifted_speeds
+    from ridempc.mpc.reference import select_reference
+    from ridempc.mpc.switch_blend import first_push_time
+
+    reference = select_reference("cyberdog2", "skateboard", "repush", 0.7)
+    layout = StateLayout.from_pair(reference.state_names, load_mpc_pair("cyberdog2", "skateboard"))
+    names = layout.names
+    n, dt = 30, 0.05
+    window = reference.states_at(first_push_time(reference) + dt * np.arange(n + 1))
+    window[:, names["board_yaw"]] += 0.3  # a board turned in the library frame
+    problem = _problem(window[0].copy(), window, dt)
+    slower = window[0, names["board_v"]] - 0.1
+    shifted = shifted_speeds(problem, layout, slower).state_reference
+    change = shifted - window
+    assert shifted[0, names["board_v"]] == pytest.approx(slower)
+    np.testing.assert_allclose(change[:, names["board_v"]], -0.1)  # the gain is kept
+    heading = window[:, names["board_yaw"]]
+    np.testing.assert_allclose(change[:, names["vx"]], -0.1 * np.cos(heading))
+    np.testing.assert_allclose(change[:, names["vy"]], -0.1 * np.sin(heading))
+    for axis, trig in (("x", np.cos), ("y", np.sin)):
+        steps = np.diff(change[:, names[f"board_{axis}"]])
+        np.testing.assert_allclose(steps, -0.1 * trig(heading[:-1]) * dt, atol=1e-12)
+        np.testing.assert_allclose(
+            change[:, names[f"com_{axis}"]], change[:, names[f"board_{axis}"]]
+        )
+    assert change[0, names["com_x"]] == 0.0 and not np.any(change[:, names["com_z"]])

@@ -33,6 +33,9 @@ class Controller(ABC):
             ahead (the simulation sets the scenario's timeline); None when only the
             present command is known. A tracking controller (the MPC) may read the
             reference over its horizon from it; nothing of the robot or board is in it.
+        turn_preview: The commanded yaw rate [rad/s] at any time [s] as a path follower
+            expects to ask it (the path's turns ahead), or None; for choices made ahead of
+            a turn (which foot pushes), not tracked.
     """
 
     rate_hz: float = 500.0
@@ -42,6 +45,7 @@ class Controller(ABC):
         self.robot = robot
         self.board = board  # the board's name ("none" on flat ground)
         self.command_preview: Callable[[float], Command] | None = None
+        self.turn_preview: Callable[[float], float] | None = None
 
     def hold_speed(self) -> None:  # noqa: B027 - optional hook
         """Push again while rolling to hold the commanded speed (a scenario's

@@ -97,6 +97,10 @@ class PathFollowing(Controller):
         self._frame: PathFrame | None = None  # the rider's pose at the path's start
         self._yaw_rate = 0.0
         self._timeline: Callable[[float], Command] | None = None
+        # when the law last ran [s], the arc it read the curvature at [m], the rider's speed
+        # [m/s] and that curvature [1/m]: the turn ahead (turn_ahead)
+        self._ahead: tuple[float, float, float, float] | None = None
+        inner.turn_preview = self.turn_ahead
         self._diagnostics: dict[str, float] = {}
 
     @property
@@ -113,6 +117,23 @@ class PathFollowing(Controller):
     def _preview(self, t: float) -> Command:
         assert self._timeline is not None
         return self._steered(self._timeline(t), t)
+
+    def turn_ahead(self, t: float) -> float:
+        """The yaw rate [rad/s] the law expects to ask at ``t`` [s]: its latest plus the
+        change of the path's curvature between where the rider is and where she will be
+        by then at her speed, :math:`v (\\kappa_p(s + v (t - t_0)) - \\kappa_p(s))`."""
+        if t < self.path.start:
+            return 0.0
+        if self._ahead is None or t <= self._ahead[0]:
+            return self._yaw_rate
+        time, arc, speed, curvature = self._ahead
+        geometry = self.geometry
+        later = float(geometry.curvature[geometry.at_arc(arc + speed * (t - time))])
+        wanted = self._yaw_rate + speed * (later - curvature)
+        if self.max_yaw_rate is not None:
+            bound = self.max_yaw_rate(speed)
+            wanted = max(-bound, min(bound, wanted))
+        return wanted
 
     def _steered(self, command: Command, t: float) -> Command:
         if t < self.path.start:
@@ -138,6 +159,8 @@ class PathFollowing(Controller):
         ahead = geometry.at_arc(geometry.arc[self._index] + max(speed, 0.0) * self.preview)
         error = math.remainder(heading - path_heading, 2.0 * math.pi)
         wanted = path_yaw_rate(cross, error, float(geometry.curvature[ahead]), speed, self.distance)
+        arc = float(geometry.arc[ahead])
+        self._ahead = (sensors.time, arc, max(speed, 0.0), float(geometry.curvature[ahead]))
         if self.max_yaw_rate is not None:
             bound = self.max_yaw_rate(speed)
             wanted = max(-bound, min(bound, wanted))
@@ -151,6 +174,7 @@ class PathFollowing(Controller):
         self._index = None
         self._frame = None
         self._yaw_rate = 0.0
+        self._ahead = None
         self.inner.reset(sensors)
 
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:

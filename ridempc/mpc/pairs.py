@@ -34,6 +34,7 @@ from ridempc.pair_description import (
     load_pair_description,
     pair_description_names,
 )
+from ridempc.trajopt.mirror import Symmetry, symmetry_or_none
 from ridempc.trajopt.pairs import Pair, load_pair
 from ridempc.trajopt.ride_pair import ride_models
 from ridempc.trajopt.ride_problem import ride_layout
@@ -121,6 +122,8 @@ class MpcPair(NamedTuple):
         settle: What the reference does after its end besides riding on (the ``settle``
             stage, :mod:`~ridempc.mpc.settle`: the robot settles back over its feet), or
             None for nothing.
+        symmetry: The robot's left-right symmetry, whose mirror images of the library's
+            re-pushes push from the other side (:mod:`~ridempc.mpc.push_side`), or None.
     """
 
     pair: Pair
@@ -147,6 +150,7 @@ class MpcPair(NamedTuple):
     plan_latency: int = 0
     roll_lead: float = 0.0
     settle: Callable[[MotionReference], MotionReference] | None = None
+    symmetry: Symmetry | None = None
 
 
 def surface_rotations(pair: MpcPair, x0: Array) -> Array:
@@ -220,6 +224,7 @@ def _skate(description: PairDescription) -> MpcPair:
             if settle is not None
             else None
         ),
+        symmetry=symmetry_or_none(robot),
         **_settings(description),
     )
 

@@ -126,6 +126,8 @@ from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.push_gain import shifted_speeds
+from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.riding_posture import ride_qpos
 from ridempc.mpc.roll_observer import RollObserver
@@ -341,6 +343,10 @@ class MpcRider(Controller):
         )
         self.pinocchio = build_pinocchio_robot(robot)
         self.selector = ManoeuvreSelector(robot.name, board)
+        symmetry = self.pair.symmetry  # each re-push from the side its turn needs
+        self.push_side = (
+            PushSide(symmetry) if symmetry is not None and REPUSH in self.selector.targets else None
+        )
         first = self.selector.initial()
         self.mpc = LinearMpc.from_library(
             robot.name, board, first.library_kind, first.target, settings
@@ -638,6 +644,12 @@ class MpcRider(Controller):
         began = wanted is not self.manoeuvre
         if began:
             self.mpc.retarget(wanted.library_kind, wanted.target)
+            if wanted.kind == REPUSH and self.push_side is not None:
+                self.mpc.reference = self.push_side.reference(
+                    self.mpc.reference,
+                    self._yaw_rate_ahead(command, now, first_stride(self.mpc.reference)),
+                    self.pair.board_states,
+                )
             reference = self.mpc.reference
             start = self.selector.phase_start(
                 reference.times,
@@ -770,6 +782,8 @@ class MpcRider(Controller):
         # slows more than its model, had the MPC push the body forward and brake the deck.
         if inputs.coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
+        elif inputs.manoeuvre[0] == REPUSH:  # from the first push: the planned gain
+            problem = shifted_speeds(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, inputs.roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
@@ -1058,6 +1072,17 @@ class MpcRider(Controller):
         if planned is not None:
             return planned
         return np.full(settings.horizon, float(command.yaw_rate))
+
+    def _yaw_rate_ahead(self, command: Command, now: float, window: tuple[float, float]) -> float:
+        """The commanded yaw rate [rad/s] averaged over ``window`` [s] from ``now``: as a
+        path follower expects to ask it (``turn_preview``), else where the ride's commands
+        are planned, else the present one."""
+        dt = self.mpc.settings.dt
+        times = now + window[0] + dt * np.arange(max(1, round((window[1] - window[0]) / dt)))
+        if self.turn_preview is not None:
+            return float(np.mean([self.turn_preview(float(t)) for t in times]))
+        planned = self._planned("yaw_rate", times)
+        return float(np.mean(planned)) if planned is not None else float(command.yaw_rate)
 
     def _speed_preview_s(self) -> float:
         """How far ahead the manoeuvre reads a planned speed [s]: the MPC's horizon where the
