@@ -185,8 +185,10 @@ class DisturbanceStage(_Frozen):
     time_constant: Positive = Field(le=10.0, description="Low-pass of the estimate [s].")
     max_linear: Positive = Field(le=100.0, description="Bound on a linear row [m/s^2].")
     max_angular: Positive = Field(le=1000.0, description="Bound on an angular row [rad/s^2].")
-    rows: tuple[Literal["linear", "angular", "board"], ...] = Field(
-        default=("linear", "angular", "board"), min_length=1, description="Rows estimated."
+    rows: tuple[Literal["horizontal", "vertical", "angular", "board"], ...] = Field(
+        default=("horizontal", "vertical", "angular", "board"),
+        min_length=1,
+        description="Rows estimated.",
     )
 
 

@@ -86,7 +86,7 @@ def test_it_finds_a_constant_disturbance_and_the_loop_has_no_offset() -> None:
     """Within 3 s (100 ticks, ten time constants of 0.3 s) the estimate is within 2 % of
     the hidden acceleration and the mass stands at its reference within 1 mm; the same MPC
     without the observer stands off by the force its weights trade for the offset."""
-    rows, angular = disturbance_rows(NAMES, {}, ("linear",))
+    rows, angular = disturbance_rows(NAMES, {}, ("horizontal",))
     assert rows == (1,) and angular == (False,)
     observer = DisturbanceObserver(rows, angular, 0.3, 3.0, 10.0)
     x = _ride(observer)
@@ -140,7 +140,7 @@ def test_the_rows_come_from_canonical_names() -> None:
 
 
 def test_a_bad_stage_names_the_file_and_the_field(tmp_path: Path) -> None:
-    text = (pairs_dir() / "cassie-segway.toml").read_text()
+    text = (pairs_dir() / "cassie-segway.toml").read_text().split("[stages.disturbance]")[0]
     stage = "\n[stages.disturbance]\ntime_constant = 0.3\nmax_linear = 3.0\nmax_angular = 10.0\n"
     bad = text + stage + 'rows = ["legs"]\n'
     path = tmp_path / "cassie-segway.toml"

@@ -57,13 +57,16 @@ __all__ = [
     "ANGULAR_ROWS",
     "BOARD_RATES",
     "DisturbanceObserver",
-    "LINEAR_ROWS",
+    "GROUPS",
+    "HORIZONTAL_ROWS",
+    "VERTICAL_ROWS",
     "disturbance_rows",
 ]
 
 Array = NDArray[np.float64]
 # The rider's centroidal velocity rows, by their canonical names in the MPC's state.
-LINEAR_ROWS: tuple[str, ...] = ("vx", "vy", "vz")
+HORIZONTAL_ROWS: tuple[str, ...] = ("vx", "vy")
+VERTICAL_ROWS: tuple[str, ...] = ("vz",)
 ANGULAR_ROWS: tuple[str, ...] = ("wx", "wy", "wz")
 # The board's states that are rates of others (canonical quantities), with whether each is
 # an angular rate (else a speed [m/s]).
@@ -73,7 +76,9 @@ BOARD_RATES: Mapping[str, bool] = {
     "roll_rate": True,
     "yaw_rate": True,
 }
-GROUPS: tuple[str, ...] = ("linear", "angular", "board")  # the rows a pair may choose
+# The rows a pair may choose: the rider's horizontal and vertical centroidal velocity, its
+# angular velocity, the board's rates.
+GROUPS: tuple[str, ...] = ("horizontal", "vertical", "angular", "board")
 
 
 def disturbance_rows(
@@ -86,7 +91,7 @@ def disturbance_rows(
     Args:
         state_names: The MPC's state names (canonical rider names ``vx`` ... ``wz``).
         board_states: The board's states by name, with their canonical quantities.
-        groups: Which of :data:`GROUPS` to take (``linear``, ``angular``, ``board``).
+        groups: Which of :data:`GROUPS` to take.
 
     Raises:
         ValueError: An unknown group.
@@ -96,8 +101,10 @@ def disturbance_rows(
         raise ValueError(f"unknown disturbance rows '{unknown[0]}' (valid: {', '.join(GROUPS)})")
     names = list(state_names)
     rows: list[tuple[int, bool]] = []
-    if "linear" in groups:
-        rows += [(names.index(n), False) for n in LINEAR_ROWS if n in names]
+    if "horizontal" in groups:
+        rows += [(names.index(n), False) for n in HORIZONTAL_ROWS if n in names]
+    if "vertical" in groups:
+        rows += [(names.index(n), False) for n in VERTICAL_ROWS if n in names]
     if "angular" in groups:
         rows += [(names.index(n), True) for n in ANGULAR_ROWS if n in names]
     if "board" in groups:

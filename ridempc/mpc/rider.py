@@ -520,8 +520,11 @@ class MpcRider(Controller):
         )
 
     def _observe_disturbance(self, x0: Array, now: float, balancing: bool) -> Array:
-        """The disturbance estimated from the last plan's prediction of ``x0``, held while
-        the backup law rides; as a drift of the MPC's rates."""
+        """The disturbance estimated from the last plan's prediction of ``x0``
+        (:mod:`~ridempc.mpc.disturbance`), as a drift of the MPC's rates: estimated while
+        balancing (holding or coasting), held through a manoeuvre (its accelerations are
+        not a constant disturbance: estimated through ``velocity-steps``' speed changes the
+        Hovershoes fell) and while the backup law rides (the plan is not followed)."""
         observer = self.disturbance
         assert observer is not None
         turn = math.remainder(self.map.frame.yaw - self._plan_frame.yaw, 2.0 * math.pi)
