@@ -151,3 +151,36 @@ def test_a_bad_stage_names_the_file_and_the_field(tmp_path: Path) -> None:
     path.write_text(text + "\n[stages.disturbance]\nmax_linear = 3.0\nmax_angular = 10.0\n")
     with pytest.raises(ConfigError, match="stages.disturbance.time_constant"):
         read_pair_file(path)
+
+
+def test_a_rider_with_the_stage_estimates_while_it_balances() -> None:
+    """The stage wired into the MPC rider (the CyberDog2 standing on the skateboard, 0.3 s):
+    its vertical row is read at each MPC tick after the first, stays finite and within its
+    bound, and the rider stands."""
+    from ridempc.boards import load_board
+    from ridempc.mpc.rider import MpcRider
+    from ridempc.pair_description import DisturbanceStage
+    from ridempc.robots import load_robot
+    from ridempc.scenarios import resolve_scenario
+    from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
+    from ridempc.sim.scene import build_scene
+    from ridempc.sim.simulation import Simulation
+
+    dog = load_robot("cyberdog2")
+    rider = MpcRider(dog, "skateboard")
+    stage = DisturbanceStage(
+        time_constant=0.3, max_linear=3.0, max_angular=10.0, rows=("vertical",)
+    )
+    description = rider.pair.description
+    stages = description.stages.model_copy(update={"disturbance": stage})
+    rider.pair = rider.pair._replace(description=description.model_copy(update={"stages": stages}))
+    rider.disturbance = rider._disturbance_observer()
+    assert rider.disturbance is not None
+    assert rider.disturbance.rows == (rider.mpc.reference.state_names.index("vz"),)
+    scenario = resolve_scenario("stand-still", "skateboard").with_duration(0.3)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    result = Simulation(scene, rider, scenario).run()
+    estimate = rider.disturbance.estimate
+    assert np.all(np.isfinite(estimate)) and np.all(np.abs(estimate) <= 3.0)
+    assert estimate[0] != 0.0
+    assert not result.fell
