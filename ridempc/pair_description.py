@@ -181,6 +181,17 @@ class SettleStage(_Frozen):
     duration: Positive = Field(le=10.0, description="Settle over the feet in this [s].")
 
 
+class DisturbanceStage(_Frozen):
+    time_constant: Positive = Field(le=10.0, description="Low-pass of the estimate [s].")
+    max_linear: Positive = Field(le=100.0, description="Bound on a linear row [m/s^2].")
+    max_angular: Positive = Field(le=1000.0, description="Bound on an angular row [rad/s^2].")
+    rows: tuple[Literal["horizontal", "vertical", "angular", "board"], ...] = Field(
+        default=("horizontal", "vertical", "angular", "board"),
+        min_length=1,
+        description="Rows estimated.",
+    )
+
+
 class Stages(_Frozen):
     """The MPC rider's per-pair stages; a stage left out is not used."""
 
@@ -198,6 +209,7 @@ class Stages(_Frozen):
     push_weights: PushWeightsStage | None = None
     settle: SettleStage | None = None
     payload: Used | None = None
+    disturbance: DisturbanceStage | None = None
 
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
@@ -220,6 +232,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "push_weights": (frozenset(), ()),
     "settle": (frozenset(), ()),
     "payload": (frozenset(), ()),
+    "disturbance": (frozenset(), ()),
 }
 
 

@@ -101,6 +101,7 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.disturbance import DisturbanceObserver, disturbance_rows
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
@@ -377,6 +378,7 @@ class MpcRider(Controller):
         # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
         self.crouch = Crouch.of(robot, board)
         self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
+        self.disturbance = self._disturbance_observer()  # offset-free MPC (mpc/disturbance.py)
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_pair(reference.state_names, self.pair)
@@ -507,6 +509,34 @@ class MpcRider(Controller):
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
         self._diagnostics: dict[str, float] = {}
+
+    def _disturbance_observer(self) -> DisturbanceObserver | None:
+        """With the ``disturbance`` stage, the observer of the model's steady error on its
+        velocity rows (:mod:`~ridempc.mpc.disturbance`)."""
+        stage = self.pair.description.stages.disturbance
+        if stage is None:
+            return None
+        names = self.mpc.reference.state_names
+        rows, angular = disturbance_rows(names, self.pair.board_states, stage.rows)
+        planar = (names.index("vx"), names.index("vy")) if "vx" in names else None
+        return DisturbanceObserver(
+            rows, angular, stage.time_constant, stage.max_linear, stage.max_angular, planar
+        )
+
+    def _observe_disturbance(self, x0: Array, now: float, balancing: bool) -> Array:
+        """The disturbance estimated from the last plan's prediction of ``x0``
+        (:mod:`~ridempc.mpc.disturbance`), as a drift of the MPC's rates: estimated while
+        balancing (holding or coasting), held through a manoeuvre (its accelerations are
+        not a constant disturbance: estimated through ``velocity-steps``' speed changes the
+        Hovershoes fell) and while the backup law rides (the plan is not followed)."""
+        observer = self.disturbance
+        assert observer is not None
+        turn = math.remainder(self.map.frame.yaw - self._plan_frame.yaw, 2.0 * math.pi)
+        elapsed, dt = now - self._plan_time, self.mpc.settings.dt
+        hold = self.handover.on_backup or self._pending is not None or not balancing
+        observer.update(x0, self._plan, now, elapsed, dt, turn, hold)
+        self._diagnostics["disturbance_max"] = float(np.max(np.abs(observer.estimate), initial=0))
+        return observer.drift(len(x0))
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
         """With the ``shoe_observer`` stage (Hovershoes), the observer of where each foot
@@ -692,6 +722,9 @@ class MpcRider(Controller):
         if self.payload is not None:
             payload = self.payload.estimate.drift(len(x0), names["vz"])
             drift = payload if drift is None else drift + payload
+        if self.disturbance is not None:
+            observed = self._observe_disturbance(x0, now, balancing)
+            drift = observed if drift is None else drift + observed
         if self.lean is not None:
             centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
             if centrifugal is not None:
