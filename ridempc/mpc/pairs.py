@@ -111,10 +111,11 @@ class MpcPair(NamedTuple):
             ``command_preview``), the manoeuvre follows the speed command planned for the
             end of the MPC's horizon, as the yaw rate and the deck roll are read over it:
             the rider leans into a planned speed step before it comes.
-        plan_latency: Control ticks (2 ms each) from the state an MPC solve starts from to
-            the tick its plan takes over (:class:`~ridempc.mpc.rider.MpcRider`): with 1,
-            OSQP iterates in a thread beside the control loop, as on the robots; with 0
-            the loop waits for it in the tick.
+        plan_latency: Control ticks (2 ms each) from the MPC's tick to the tick its plan
+            takes over (:class:`~ridempc.mpc.rider.MpcRider`), the plan solved from the
+            state predicted there (:mod:`~ridempc.mpc.delay`): with 1, OSQP iterates in a
+            thread beside the control loop, from 2 the problem is built and solved in a
+            process of its own, as on the robots; with 0 the loop waits for it in the tick.
         roll_lead: How far ahead of each horizon node the commanded deck roll is read [s]
             (the ``roll_lead`` stage): the closed loop's deck follows the plan's roll late
             (the MPC's steps, the whole-body QP's tracking, the trucks).
