@@ -116,6 +116,9 @@ class MpcPair(NamedTuple):
             state predicted there (:mod:`~ridempc.mpc.delay`): with 1, OSQP iterates in a
             thread beside the control loop, from 2 the problem is built and solved in a
             process of its own, as on the robots; with 0 the loop waits for it in the tick.
+        predict_start: Whether a plan taken up ``plan_latency`` ticks late is solved from
+            the state predicted at its take-up (:mod:`~ridempc.mpc.delay`), else from the
+            tick's, its time shifted.
         roll_lead: How far ahead of each horizon node the commanded deck roll is read [s]
             (the ``roll_lead`` stage): the closed loop's deck follows the plan's roll late
             (the MPC's steps, the whole-body QP's tracking, the trucks).
@@ -146,6 +149,7 @@ class MpcPair(NamedTuple):
     stance_roll: float | None = None
     speed_preview: bool = False
     plan_latency: int = 0
+    predict_start: bool = True
     roll_lead: float = 0.0
     settle: Callable[[MotionReference], MotionReference] | None = None
 
@@ -184,6 +188,7 @@ def _settings(description: PairDescription) -> dict[str, Any]:
         "stance_roll": stages.stance.roll_offset if stages.stance is not None else None,
         "speed_preview": mpc.speed_preview,
         "plan_latency": mpc.plan_latency,
+        "predict_start": mpc.predict_start,
         "roll_lead": stages.roll_lead.lead if stages.roll_lead is not None else 0.0,
         "description": description,
     }

@@ -309,9 +309,6 @@ class MpcRider(Controller):
     # thread), the thread; ``thread``, the solver thread (its Python holds the loop's
     # lock: only OSQP's iterations run beside the loop); ``tick``, in its tick.
     off_tick: str = "process"
-    # Whether a plan taken up ``plan_latency`` ticks late is solved from the state
-    # predicted at its take-up (mpc/delay.py), else from the tick's, its time shifted.
-    predicts_start: bool = True
     # Whether the solver process sends each problem back with its plan (the bench keeps
     # them; the ride needs the plan only).
     keeps_problems: bool = False
@@ -339,6 +336,9 @@ class MpcRider(Controller):
         if latency < 0 or latency >= MPC_DIVIDER:
             raise ValueError(f"plan_latency must be 0 to {MPC_DIVIDER - 1} ticks, got {latency}")
         self.plan_latency = latency
+        # A plan taken up late solved from the state predicted at its take-up (mpc/delay.py),
+        # else from the tick's, its time shifted (the pair's ``predict_start``).
+        self.predicts_start = self.pair.predict_start
         loaded = load_board(board)
         n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
         self.platform_feet = platform_feet(robot, n_platforms)
