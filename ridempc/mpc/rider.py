@@ -11,14 +11,15 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Segway the problem is built and
-   solved in a process of its own, as the robots run their MPC beside their WBC, from what
-   the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``; on the Hovershoes in a
-   thread), and the plan takes over two ticks (4 ms; the Hovershoes one) after the state it
-   is solved from, carried over those ticks by the reduced model (:mod:`ridempc.mpc.delay`),
-   waited for then whatever the machine, the ticks between following the
-   previous plan in its own library frame: the pair's ``plan_latency``; the skateboard's is
-   built and solved in its tick) on the manoeuvre the command asks for
+   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Segway and the skateboard the
+   problem is built and solved in a process of its own, as the robots run their MPC beside
+   their WBC, from what the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``;
+   on the Hovershoes in a thread), and the plan takes over two ticks (4 ms; the Hovershoes
+   one) after the MPC's tick, solved from the state predicted there by the reduced model
+   (:mod:`ridempc.mpc.delay`; the Hovershoes' from the tick's state, its time shifted: the
+   pair's ``predict_start``), waited for then whatever the machine, the ticks between
+   following the previous plan in its own library frame: the pair's ``plan_latency``) on
+   the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
