@@ -216,16 +216,44 @@ def _record(
     wbc_inputs: list = []
 
     class Recording(MpcRider):
+        """The rider, its MPC problems kept: those built in the loop's thread (or the
+        solver thread) as each plan is taken up; those of the solver process in the child,
+        sent back together when the ride closes it (a problem is a few hundred kB: sent
+        with each plan, reading it made the bench's take-up ticks slower than a ride's)."""
+
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            super().__init__(*args, **kwargs)
+            self.kept: list = []  # the child's problems, in the child
+            self.remote = 0  # plans taken up from the child, in the parent
+
+        def _build_in_process(self, inputs: Any) -> Any:
+            if inputs is None:  # the ride's end: every problem the child built
+                return self.kept
+            built = self._build_and_run(inputs)
+            self.kept.append(built.problem)
+            return built._replace(problem=None)
+
         def _adopt(self, solve: Any, built: Any) -> None:
             super()._adopt(solve, built)
-            problems.append(built.problem)
+            if built.problem is None:
+                self.remote += 1
+            else:
+                problems.append(built.problem)
+
+        def close(self) -> None:
+            if self._worker is not None:
+                pending = self._pending
+                if pending is not None and pending.reply is not None:
+                    pending.reply.result()  # each reply is read before the next submit
+                kept = self._worker.submit(None).result()  # type: ignore[arg-type]
+                problems.extend(kept[: self.remote])
+            super().close()
 
     robot = load_robot(robot_name)
     rider = Recording(robot, board_name, wbc_solver=wbc_solver)
     # profiled, the MPC's problems are built in the loop's thread (the same ride): the
     # profiler sees that thread only
     rider.off_tick = "process" if profiler is None else "tick"
-    rider.keeps_problems = True
     parts = {"estimator": 0.0, "wbc": 0.0}  # [s] spent in each over the ride
     solve = _timed(rider.wbc.solve, parts, "wbc")
 

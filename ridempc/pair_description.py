@@ -120,6 +120,10 @@ class MpcSection(_Frozen):
         lt=MPC_DIVIDER_TICKS,
         description="Control ticks from a solve's state to the tick its plan takes over.",
     )
+    predict_start: Flag = Field(
+        default=True,
+        description="Solve a late plan from the state predicted at its take-up (mpc/delay.py).",
+    )
     unrealised_inputs: tuple[str, ...] = Field(
         default=(), description="Board inputs the rider does not realise, held at zero."
     )

@@ -44,11 +44,11 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
     after the state it starts from (the first at once), timed from that state; the ticks
     between follow the previous plan. The ride does not depend on how fast the thread or
     the process runs, nor on where the MPC runs (the process, the thread, the tick): the
-    rides are the same, bit for bit. The Hovershoes ride so, the Segway two ticks on (from
-    the process); the skateboard waits for each plan in its tick (the pairs' ``plan_latency``)."""
+    rides are the same, bit for bit. The Hovershoes ride so, the Segway and the skateboard
+    two ticks on (from the process; the pairs' ``plan_latency``)."""
     assert load_mpc_pair("cassie", "hovershoes").plan_latency == 1
     assert load_mpc_pair("cassie", "segway").plan_latency == 2
-    assert MpcRider(dog, "skateboard").plan_latency == 0
+    assert MpcRider(dog, "skateboard").plan_latency == 2
     with pytest.raises(ValueError, match="plan_latency"):
         MpcRider(dog, "skateboard", plan_latency=MPC_DIVIDER)
     rider = MpcRider(dog, "skateboard", plan_latency=1)
@@ -239,7 +239,7 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
     Through the push and the foot's return to the deck the plan is realised: the trunk's
     roll rate, one MPC step on, is where the plan put it, and the board keeps the
     library's speed."""
-    rider = MpcRider(dog, "skateboard")
+    rider = MpcRider(dog, "skateboard", plan_latency=0)  # each problem read as it is solved
     scenario = resolve_scenario("push-off-0.7", "skateboard").with_duration(2.5)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
     seen: list[tuple[float, tuple, tuple[str, ...], bool]] = []
@@ -323,7 +323,7 @@ def test_a_push_off_reaches_its_target_and_coasts_on(dog, seed: int) -> None:
     push-off's speed weights, :mod:`ridempc.mpc.push_weights`), and the rider then coasts
     on four legs: the MPC's reference speed is the board's own, the library frame follows
     the board along its line, and the rider stays up."""
-    rider = MpcRider(dog, "skateboard")
+    rider = MpcRider(dog, "skateboard", plan_latency=0)  # each problem read as it is solved
     scenario = resolve_scenario("push-off-0.3", "skateboard").with_duration(4.0)
     scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
     n = rider.layout.names

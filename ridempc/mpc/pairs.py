@@ -112,10 +112,14 @@ class MpcPair(NamedTuple):
             ``command_preview``), the manoeuvre follows the speed command planned for the
             end of the MPC's horizon, as the yaw rate and the deck roll are read over it:
             the rider leans into a planned speed step before it comes.
-        plan_latency: Control ticks (2 ms each) from the state an MPC solve starts from to
-            the tick its plan takes over (:class:`~ridempc.mpc.rider.MpcRider`): with 1,
-            OSQP iterates in a thread beside the control loop, as on the robots; with 0
-            the loop waits for it in the tick.
+        plan_latency: Control ticks (2 ms each) from the MPC's tick to the tick its plan
+            takes over (:class:`~ridempc.mpc.rider.MpcRider`), the plan solved from the
+            state predicted there (:mod:`~ridempc.mpc.delay`): with 1, OSQP iterates in a
+            thread beside the control loop, from 2 the problem is built and solved in a
+            process of its own, as on the robots; with 0 the loop waits for it in the tick.
+        predict_start: Whether a plan taken up ``plan_latency`` ticks late is solved from
+            the state predicted at its take-up (:mod:`~ridempc.mpc.delay`), else from the
+            tick's, its time shifted.
         roll_lead: How far ahead of each horizon node the commanded deck roll is read [s]
             (the ``roll_lead`` stage): the closed loop's deck follows the plan's roll late
             (the MPC's steps, the whole-body QP's tracking, the trucks).
@@ -148,6 +152,7 @@ class MpcPair(NamedTuple):
     stance_roll: float | None = None
     speed_preview: bool = False
     plan_latency: int = 0
+    predict_start: bool = True
     roll_lead: float = 0.0
     settle: Callable[[MotionReference], MotionReference] | None = None
     symmetry: Symmetry | None = None
@@ -187,6 +192,7 @@ def _settings(description: PairDescription) -> dict[str, Any]:
         "stance_roll": stages.stance.roll_offset if stages.stance is not None else None,
         "speed_preview": mpc.speed_preview,
         "plan_latency": mpc.plan_latency,
+        "predict_start": mpc.predict_start,
         "roll_lead": stages.roll_lead.lead if stages.roll_lead is not None else 0.0,
         "description": description,
     }

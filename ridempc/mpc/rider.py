@@ -11,13 +11,15 @@ Every 2 ms (500 Hz) the rider
    reference's line: speeds and turn rates are commanded, not a path; on a board the
    rider cannot steer, the Segway, it also turns with the board's direction of travel)
    and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Segway the problem is built and
-   solved in a process of its own, as the robots run their MPC beside their WBC, from what
-   the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``; on the Hovershoes in a
-   thread), and the plan takes over two ticks (4 ms; the Hovershoes one) after the state it
-   starts from, waited for then whatever the machine, the ticks between following the
-   previous plan in its own library frame: the pair's ``plan_latency``; the skateboard's is
-   built and solved in its tick) on the manoeuvre the command asks for
+   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Segway and the skateboard the
+   problem is built and solved in a process of its own, as the robots run their MPC beside
+   their WBC, from what the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``;
+   on the Hovershoes in a thread), and the plan takes over two ticks (4 ms; the Hovershoes
+   one) after the MPC's tick, solved from the state predicted there by the reduced model
+   (:mod:`ridempc.mpc.delay`; the Hovershoes' from the tick's state, its time shifted: the
+   pair's ``predict_start``), waited for then whatever the machine, the ticks between
+   following the previous plan in its own library frame: the pair's ``plan_latency``) on
+   the manoeuvre the command asks for
    (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
    trajectory, then rides on steadily (on the skateboard, which only a push drives, it
    coasts: the steady ride is slowed to the board's speed,
@@ -101,6 +103,7 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
+from ridempc.mpc.delay import predicted_start
 from ridempc.mpc.disturbance import DisturbanceObserver, disturbance_rows
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
@@ -184,7 +187,9 @@ class _BuildInputs(NamedTuple):
     observer (frozen, or None), the manoeuvre's kind and target, the plan in force's
     first input (or None), the contacts of the last MPC step, the reference tracked
     when it changed at this tick (else None), whether any manoeuvre began at this tick,
-    and the commanded lateral offset of the feet [m] (:mod:`~ridempc.mpc.foot_spread`)."""
+    and the commanded lateral offset of the feet [m] (:mod:`~ridempc.mpc.foot_spread`);
+    and the delay [s] from the tick to the plan's take-up over which ``x0`` is predicted
+    (:mod:`~ridempc.mpc.delay`; ``t_ref`` and ``now`` are then the take-up's)."""
 
     t_ref: float
     x0: Array
@@ -204,6 +209,7 @@ class _BuildInputs(NamedTuple):
     reference: MotionReference | None
     began: bool
     lateral_offset: float
+    delay: float = 0.0
 
 
 class _Built(NamedTuple):
@@ -334,6 +340,9 @@ class MpcRider(Controller):
         if latency < 0 or latency >= MPC_DIVIDER:
             raise ValueError(f"plan_latency must be 0 to {MPC_DIVIDER - 1} ticks, got {latency}")
         self.plan_latency = latency
+        # A plan taken up late solved from the state predicted at its take-up (mpc/delay.py),
+        # else from the tick's, its time shifted (the pair's ``predict_start``).
+        self.predicts_start = self.pair.predict_start
         loaded = load_board(board)
         n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
         self.platform_feet = platform_feet(robot, n_platforms)
@@ -730,11 +739,14 @@ class MpcRider(Controller):
             if centrifugal is not None:
                 drift = centrifugal if drift is None else drift + centrifugal
             self._diagnostics["lean_offset"] = self.lean.offset
+        # the plan starts where it takes over (mpc/delay.py): the first plan is waited for
+        late = self.plan_latency > 0 and self._plan is not None and self.predicts_start
+        delay = self.plan_latency / self.rate_hz if late else 0.0
         inputs = _BuildInputs(  # what the loop's state says now, copied: the build may run
-            t_ref,  # beside the loop's next ticks, which move the shoes' observer on
+            self.manoeuvre.reference_time(now + delay),  # beside the loop's next ticks,
             x0,
-            drift,
-            now,
+            drift,  # which move the shoes' observer on
+            now + delay,
             speed,
             roll,
             turn,
@@ -749,11 +761,12 @@ class MpcRider(Controller):
             None if self.mpc.reference is self._sent_reference else self.mpc.reference,
             began,
             command.lateral_offset,
+            delay,
         )
         self._sent_reference = self.mpc.reference
         # the frame the plan is in: the map's moves on at the next tick, the plan only
         # when this one takes over
-        pending = _PendingSolve(self.map.frame, now, self._tick + self.plan_latency)
+        pending = _PendingSolve(self.map.frame, now + delay, self._tick + self.plan_latency)
         if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
             self._adopt(pending, self._build_and_run(inputs))
         else:
@@ -788,7 +801,20 @@ class MpcRider(Controller):
         started = time.perf_counter()
         if inputs.reference is not None:
             self.mpc.reference = inputs.reference
-        problem = self._shaped(self.mpc.problem(inputs.t_ref, inputs.x0, inputs.drift), inputs)
+        x0 = inputs.x0
+        if inputs.delay > 0.0 and inputs.first_input is not None:
+            mpc = self.mpc
+            x0 = predicted_start(
+                mpc.model,
+                mpc.reference,
+                inputs.t_ref,
+                x0,
+                inputs.first_input,
+                inputs.drift,
+                inputs.delay,
+                mpc.settings.dt,
+            )
+        problem = self._shaped(self.mpc.problem(inputs.t_ref, x0, inputs.drift), inputs)
         if self.mpc.qp is None:
             self.mpc.qp = self.mpc.build_qp(problem)
         build = time.perf_counter() - started
