@@ -38,6 +38,7 @@ from ridempc.autonomy.straddle import (
     StraddleSettings,
     lane_walls,
 )
+from ridempc.autonomy.straddle_decision import StraddleTracker
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner, TebSettings
 from ridempc.controllers.base import Controller
 from ridempc.scenarios.scenario import Command
@@ -150,6 +151,8 @@ class Navigator:
         self._target = (0.0, 0.0)
         self._spread = (0.0, 0.0, 0.0)  # (time, offset, target offset) of the feet [s, m, m]
         self.straddles: tuple[Straddle, ...] = ()
+        self.straddle_tracker = StraddleTracker(s.straddle)
+        self._ignored = np.zeros(grid.frame.shape, dtype=bool)  # far specks: not obstacles
         self.straddle_times: list[float] = []  # update times at which the feet were spread
         self._decel = s.accel
         self._failures_in_row = 0
@@ -297,6 +300,7 @@ class Navigator:
                 start,
                 self.goal,
                 self.settings,
+                self.straddle_tracker,
             )
         except NoPath as exc:
             self.global_times.append(time.perf_counter() - began)
@@ -304,6 +308,7 @@ class Navigator:
             return False
         self.global_times.append(time.perf_counter() - began)
         self.costmap, self.straddles = planned.costmap, planned.straddles
+        self._ignored = planned.ignored
         self.path = planned.path
         self.paths.append(self.path)
         return True
@@ -326,7 +331,7 @@ class Navigator:
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        obstacles = self.grid.occupied()
+        obstacles = self.grid.occupied() & ~self._ignored
         for straddle in self.straddles:
             obstacles &= ~straddle.cells
         return nearby_obstacles(self.grid.frame, obstacles, self.straddles, position, self.settings)
