@@ -13,6 +13,11 @@ A low obstacle narrow enough to pass between the feet (:mod:`ridempc.autonomy.st
 is not ridden round: the path runs along its axis and the feet are spread around it (the
 wave pattern's lateral offset in the command).
 
+On an incline measured on the map's ground ahead (:mod:`ridempc.autonomy.incline`) the speed
+command holds ``cruise``: gravity there moves the riders' speed off their command faster than
+the command slews, and a command cut far below the speed makes the MPC rider brake by its
+``stop`` manoeuvre, on the incline and in a turn.
+
 A band that fails ``failures_to_stop`` times in a row, or a goal that becomes unreachable,
 stops the rider (it slows at ``stop_decel`` and holds); the summary records when and why.
 """
@@ -31,6 +36,7 @@ from ridempc.autonomy.costmap import Costmap
 from ridempc.autonomy.depth_sensor import DepthSensor, mount_pose
 from ridempc.autonomy.dijkstra import NoPath
 from ridempc.autonomy.global_plan import plan_global
+from ridempc.autonomy.incline import incline_ahead
 from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import Perception
 from ridempc.autonomy.straddle import (
@@ -79,6 +85,17 @@ class NavigatorSettings:
         hold_speed: Largest speed of that hold [m/s], below the MPC's 0.05 m/s of rest.
         failures_to_stop: Band failures in a row that stop the rider.
         obstacle_radius: Map cells within this distance are the band's obstacles [m].
+        incline_hold: On an incline at least this steep [rad] the speed command holds
+            ``cruise`` (no slowing for turns): gravity's pull along the shoes, g sin 3 deg =
+            0.51 m/s^2, is twice ``accel``, so the speed leaves its command faster than the
+            command slews (the MPC rider climbed the slope course at 0.62-0.74 m/s against
+            0.5), and a turn's cut to ``min_speed`` then fell 0.44 m/s below the speed: the
+            MPC rider's ``stop`` manoeuvre, which spun and fell there.
+        incline_reach: The incline is measured this far ahead [m]: the command holds before
+            the shoes reach it (the command horizon and the slew from ``min_speed``,
+            0.5 s + 0.8 s at 0.5 m/s, are 0.65 m).
+        incline_behind: ... and from this far behind the base [m] (the shoes' contact
+            patches behind the pelvis, with the fit's half window).
         command_horizon: The command is the band's mean speed and yaw rate over its first
             this many seconds [s] (the riders lag their command by about that much).
         teb: The band's settings.
@@ -104,6 +121,9 @@ class NavigatorSettings:
     hold_speed: float = 0.04
     failures_to_stop: int = 3
     obstacle_radius: float = 2.5
+    incline_hold: float = math.radians(3.0)
+    incline_reach: float = 1.0
+    incline_behind: float = 0.3
     command_horizon: float = 0.5
     teb: TebSettings = field(default_factory=TebSettings)
     straddle: StraddleSettings = field(default_factory=StraddleSettings)
@@ -161,6 +181,8 @@ class Navigator:
         self.stop_reason: str | None = None
         self.band_failures = 0
         self.teb_times: list[float] = []
+        self.incline_times: list[float] = []  # update times at which an incline held the speed
+        self.steepest = 0.0  # steepest incline measured ahead [rad]
         self.global_times: list[float] = []
         self.perception_times: list[float] = []
         self.bands: list[Array] = []
@@ -273,7 +295,20 @@ class Navigator:
         self.bands.append(band.poses)
         v, w = band.command(self.settings.command_horizon)
         self.trace.append((t, v, w, *local_goal))
-        v = max(self.settings.min_speed, min(v, self.settings.cruise))
+        incline = incline_ahead(
+            self.grid.frame,
+            self.grid.ground,
+            base[:2],
+            yaw,
+            self.settings.incline_reach,
+            self.settings.incline_behind,
+        )
+        self.steepest = max(self.steepest, incline)
+        slowest = self.settings.min_speed
+        if incline >= self.settings.incline_hold:
+            slowest = self.settings.cruise
+            self.incline_times.append(t)
+        v = max(slowest, min(v, self.settings.cruise))
         turn = self.settings.turn_at_rest + v / self.settings.turn_radius
         w = float(np.clip(w, -turn, turn))
         self._decel = self.settings.accel
@@ -376,6 +411,8 @@ class Navigator:
                 for st in self.straddles
             ],
             "feet_spread_s": round(len(self.straddle_times) / self.settings.planner_hz, 2),
+            "incline_hold_s": round(len(self.incline_times) / self.settings.planner_hz, 2),
+            "steepest_incline_deg": round(math.degrees(self.steepest), 2),
         }
 
 
