@@ -115,6 +115,16 @@ def test_the_incline_ahead_is_measured_on_the_maps_ground(slope_deg: float) -> N
     assert across < settings.incline_hold  # the slope rises along x, level across it
 
 
+def test_a_low_box_is_no_incline() -> None:
+    poses = [(0.0, 0.0, 0.0), (0.3, 0.0, 0.1), (0.6, 0.0, -0.1), (0.9, 0.0, 0.0)]
+    grid = _map(0.0, [_box(2.2, 0.0, (0.6, 0.2, 0.1))], poses)  # the straddle course's
+    settings = NavigatorSettings()
+    incline = incline_ahead(
+        grid.frame, grid.ground, np.array([1.5, 0.0]), 0.0, 1.0, 0.3, grid.occupied()
+    )
+    assert incline < settings.incline_hold
+
+
 # the terrain issue's steps, from the Hovershoes library: 1.71 wheel radii (0.076 m), and the
 # stairs' 0.79 and 0.93 (0.035, 0.041 m); down as ridden, and up
 @pytest.mark.parametrize("rise", [-0.076, -0.041, -0.035, 0.035, 0.041, 0.076])

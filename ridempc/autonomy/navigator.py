@@ -302,6 +302,7 @@ class Navigator:
             yaw,
             self.settings.incline_reach,
             self.settings.incline_behind,
+            self.grid.occupied(),
         )
         self.steepest = max(self.steepest, incline)
         slowest = self.settings.min_speed

@@ -59,8 +59,9 @@ class OccupancyGrid:
         self.observed = np.zeros(frame.shape, dtype=bool)
         # tallest obstacle point seen in each cell over the ground [m]; -inf: none seen
         self.height = np.full(frame.shape, -np.inf)
-        # the ground's height in each cell [m], the last frame's mean of its ground points;
-        # NaN: never seen
+        # the ground's height in each cell [m], the last frame's mean of its ground points,
+        # from frames that hit no obstacle in it (a box's lower face reads as ground); NaN:
+        # never seen
         self.ground = np.full(frame.shape, np.nan)
 
     def update(
@@ -79,11 +80,12 @@ class OccupancyGrid:
         hit = np.zeros(frame.shape, dtype=bool)
         ij, inside = self._ray_cells(sensor, ground)  # a ray to an obstacle clears no floor
         free[ij[inside, 0], ij[inside, 1]] = True
-        ij, inside = frame.cells(ground[:, :2])
-        free[ij[inside, 0], ij[inside, 1]] = True
-        self._fuse_ground(ij[inside], ground[inside, 2])
         ij, inside = frame.cells(obstacles[:, :2])
         hit[ij[inside, 0], ij[inside, 1]] = True
+        on, below = frame.cells(ground[:, :2])
+        free[on[below, 0], on[below, 1]] = True
+        below[below] &= ~hit[on[below, 0], on[below, 1]]
+        self._fuse_ground(on[below], ground[below, 2])
         if heights is not None:
             np.maximum.at(self.height, (ij[inside, 0], ij[inside, 1]), heights[inside])
         free &= ~hit
