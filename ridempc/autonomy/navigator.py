@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.ndimage import binary_dilation
 
 from ridempc.autonomy.camera import CameraIntrinsics
 from ridempc.autonomy.costmap import Costmap
@@ -172,7 +173,9 @@ class Navigator:
         self._spread = (0.0, 0.0, 0.0)  # (time, offset, target offset) of the feet [s, m, m]
         self.straddles: tuple[Straddle, ...] = ()
         self.straddle_tracker = StraddleTracker(s.straddle)
-        self._ignored = np.zeros(grid.frame.shape, dtype=bool)  # far specks: not obstacles
+        # cells that are not the band's obstacles: far specks, and the straddles' cells with
+        # those joining them (a box grows as it is seen, between replans)
+        self._passed = np.zeros(grid.frame.shape, dtype=bool)
         self.straddle_times: list[float] = []  # update times at which the feet were spread
         self._decel = s.accel
         self._failures_in_row = 0
@@ -344,7 +347,12 @@ class Navigator:
             return False
         self.global_times.append(time.perf_counter() - began)
         self.costmap, self.straddles = planned.costmap, planned.straddles
-        self._ignored = planned.ignored
+        join = round(self.settings.straddle.join / grid.frame.resolution)
+        straddled = np.zeros(grid.frame.shape, dtype=bool)
+        for straddle in planned.straddles:
+            straddled |= straddle.cells
+        reach = np.ones((2 * join + 1, 2 * join + 1), dtype=bool)
+        self._passed = planned.ignored | binary_dilation(straddled, structure=reach)
         self.path = planned.path
         self.paths.append(self.path)
         return True
@@ -367,9 +375,7 @@ class Navigator:
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        obstacles = self.grid.occupied() & ~self._ignored
-        for straddle in self.straddles:
-            obstacles &= ~straddle.cells
+        obstacles = self.grid.occupied() & ~self._passed
         return nearby_obstacles(self.grid.frame, obstacles, self.straddles, position, self.settings)
 
     def trace_arrays(self) -> dict[str, Array]:
