@@ -97,6 +97,9 @@ class NavigatorSettings:
             0.5 s + 0.8 s at 0.5 m/s, are 0.65 m).
         incline_behind: ... and from this far behind the base [m] (the shoes' contact
             patches behind the pelvis, with the fit's half window).
+        incline_yaw_rate: Largest yaw rate commanded on such an incline [rad/s]: there the
+            MPC rider turned at 2-3 times its command (0.71-1.07 rad/s at 0.35) and spun;
+            at this, thrice is 0.45 rad/s, within the 0.5 rad/s it tracks on the level.
         command_horizon: The command is the band's mean speed and yaw rate over its first
             this many seconds [s] (the riders lag their command by about that much).
         teb: The band's settings.
@@ -125,6 +128,7 @@ class NavigatorSettings:
     incline_hold: float = math.radians(3.0)
     incline_reach: float = 1.0
     incline_behind: float = 0.3
+    incline_yaw_rate: float = 0.15
     command_horizon: float = 0.5
     teb: TebSettings = field(default_factory=TebSettings)
     straddle: StraddleSettings = field(default_factory=StraddleSettings)
@@ -308,12 +312,12 @@ class Navigator:
             self.grid.occupied(),
         )
         self.steepest = max(self.steepest, incline)
-        slowest = self.settings.min_speed
-        if incline >= self.settings.incline_hold:
-            slowest = self.settings.cruise
+        s = self.settings
+        on_incline = incline >= s.incline_hold
+        if on_incline:
             self.incline_times.append(t)
-        v = max(slowest, min(v, self.settings.cruise))
-        turn = self.settings.turn_at_rest + v / self.settings.turn_radius
+        v = max(s.cruise if on_incline else s.min_speed, min(v, s.cruise))
+        turn = s.incline_yaw_rate if on_incline else s.turn_at_rest + v / s.turn_radius
         w = float(np.clip(w, -turn, turn))
         self._decel = self.settings.accel
         self._retarget(t, v, w)
