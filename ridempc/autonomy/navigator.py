@@ -14,9 +14,10 @@ is not ridden round: the path runs along its axis and the feet are spread around
 wave pattern's lateral offset in the command).
 
 On an incline measured on the map's ground ahead (:mod:`ridempc.autonomy.incline`) the speed
-command holds ``cruise``: gravity there moves the riders' speed off their command faster than
-the command slews, and a command cut far below the speed makes the MPC rider brake by its
-``stop`` manoeuvre, on the incline and in a turn.
+command holds ``cruise`` and the yaw-rate command is bounded by ``incline_yaw_rate``: gravity
+there moves the riders' speed off their command faster than the command slews, a command cut
+far below the speed makes the MPC rider brake by its ``stop`` manoeuvre, and its turns there
+overshoot their command (both spun it, on the incline and in a turn).
 
 A band that fails ``failures_to_stop`` times in a row, or a goal that becomes unreachable,
 stops the rider (it slows at ``stop_decel`` and holds); the summary records when and why.
