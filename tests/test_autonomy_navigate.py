@@ -28,8 +28,8 @@ goal = [4.0, 0.0]
 """
 
 
-def _box(x: float, y: float, sx: float, sy: float) -> str:
-    return f"\n[[obstacles]]\ncenter = [{x}, {y}]\nsize = [{sx}, {sy}, 0.5]\n"
+def _box(x: float, y: float, sx: float, sy: float, sz: float = 0.5) -> str:
+    return f"\n[[obstacles]]\ncenter = [{x}, {y}]\nsize = [{sx}, {sy}, {sz}]\n"
 
 
 @pytest.mark.parametrize("name", course_names())
@@ -49,6 +49,28 @@ def test_an_unreachable_goal_is_bad_input(tmp_path: Path, capsys: pytest.Capture
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "field 'goal'" in err[0] and "unreachable" in err[0]
     assert not (out / "summary.json").exists()
+
+
+@pytest.mark.parametrize(("height", "reachable"), [(0.1, True), (0.5, False)])
+def test_a_course_whose_only_way_is_a_straddle_is_reachable(
+    tmp_path: Path, capsys: pytest.CaptureFixture, height: float, reachable: bool
+) -> None:
+    # the goal's room is entered by a passage 0.9 m wide, the rider's centre 0.1 m a side
+    # of its middle: no way round the box in it
+    boxes = _box(4.0, 1.0, 2.2, 0.2) + _box(4.0, -1.0, 2.2, 0.2) + _box(5.0, 0.0, 0.2, 2.2)
+    boxes += _box(3.0, 0.775, 0.2, 0.65) + _box(3.0, -0.775, 0.2, 0.65)
+    boxes += _box(2.5, 0.55, 1.0, 0.2) + _box(2.5, -0.55, 1.0, 0.2)
+    boxes += _box(2.6, 0.0, 0.6, 0.2, height)
+    course = tmp_path / "narrow.toml"
+    course.write_text(ENCLOSED.format(boxes=boxes))
+    if reachable:
+        loaded = resolve_course(str(course))
+        path = check_reachable(loaded, "narrow", NavigatorSettings())
+        assert np.linalg.norm(path[-1] - np.asarray(loaded.goal)) < 0.1
+        return
+    assert main(["navigate", "--course", str(course), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unreachable" in err[0] and "straddling" in err[0]
 
 
 def test_a_goal_inside_a_box_is_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:

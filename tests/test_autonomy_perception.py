@@ -12,6 +12,8 @@ from ridempc.autonomy.camera import CameraIntrinsics, DepthCameraSpec, pixel_ray
 from ridempc.autonomy.course import Box, resolve_course
 from ridempc.autonomy.evaluation import CellScores, score_cells
 from ridempc.autonomy.ground import segment_ground
+from ridempc.autonomy.incline import incline_ahead
+from ridempc.autonomy.navigator import NavigatorSettings
 from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import FUSE_RANGE, Perception
 from ridempc.autonomy.scan import pseudo_scan
@@ -96,6 +98,31 @@ def test_occupancy_precision_and_recall_within_3m(slope_deg: float) -> None:
     assert scores.precision >= 0.95
     assert scores.recall >= 0.95
     assert scores.false_share < 0.01
+
+
+@pytest.mark.parametrize("slope_deg", [0.0, 7.0, 13.0])
+def test_the_incline_ahead_is_measured_on_the_maps_ground(slope_deg: float) -> None:
+    poses = [(0.0, 0.0, 0.0), (0.3, 0.0, 0.1), (0.6, 0.0, -0.1)]
+    grid = _map(math.radians(slope_deg), [], poses)
+    settings = NavigatorSettings()
+    rider = np.array([1.5, 0.0])  # on ground the poses saw ahead of them
+    incline = incline_ahead(
+        grid.frame, grid.ground, rider, 0.0, settings.incline_reach, settings.incline_behind
+    )
+    assert math.degrees(incline) == pytest.approx(slope_deg, abs=1.5)
+    assert (incline >= settings.incline_hold) == (slope_deg > 0.0)
+    across = incline_ahead(grid.frame, grid.ground, rider, 0.5 * math.pi, 1.0, 0.3)
+    assert across < settings.incline_hold  # the slope rises along x, level across it
+
+
+def test_a_low_box_is_no_incline() -> None:
+    poses = [(0.0, 0.0, 0.0), (0.3, 0.0, 0.1), (0.6, 0.0, -0.1), (0.9, 0.0, 0.0)]
+    grid = _map(0.0, [_box(2.2, 0.0, (0.6, 0.2, 0.1))], poses)  # the straddle course's
+    settings = NavigatorSettings()
+    incline = incline_ahead(
+        grid.frame, grid.ground, np.array([1.5, 0.0]), 0.0, 1.0, 0.3, grid.occupied()
+    )
+    assert incline < settings.incline_hold
 
 
 # the terrain issue's steps, from the Hovershoes library: 1.71 wheel radii (0.076 m), and the

@@ -118,3 +118,22 @@ def test_a_kinematic_rider_straddles_the_low_box_with_its_feet_spread() -> None:
     assert np.abs(lateral - box.center[1]).max() < SETTINGS.lane + 0.02
     assert spread.min() == pytest.approx(SETTINGS.spread)
     assert navigator.command_at(course.duration).lateral_offset == 0.0  # closed at the goal
+
+
+def test_a_straddles_cells_seen_between_replans_are_not_the_bands_obstacles() -> None:
+    course = resolve_course("straddle").in_start_frame()
+    frame = map_frame(course)
+    grid = OccupancyGrid(frame)
+    cells = rasterise(frame, course.obstacles)
+    grid.log_odds[cells] = 3.0
+    grid.height[cells] = 0.16
+    navigator = Navigator(np.asarray(course.goal), grid, BlindSensor(), KinematicRider(), 100)  # type: ignore[arg-type]
+    rider = np.array([2.0, 0.0])
+    assert navigator._replan(rider, 0.0) and len(navigator.straddles) == 1
+    (box,) = course.obstacles
+    grown = frame.cells(np.array([[box.center[0] + 0.5 * box.size[0] + 0.03, 0.0]]))[0][0]
+    grid.log_odds[grown[0], grown[1]] = 3.0  # the box's far end, seen since the replan
+    grid.height[grown[0], grown[1]] = 0.16
+    points = navigator._nearby_obstacles(rider)
+    near_box = box.contains(points, margin=0.1)
+    assert not near_box.any()  # only the lane's walls, 0.56 m either side

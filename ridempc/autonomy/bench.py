@@ -20,9 +20,8 @@ import numpy as np
 from ridempc.autonomy.costmap import inflate
 from ridempc.autonomy.course import course_names, resolve_course
 from ridempc.autonomy.dijkstra import plan_heapq
-from ridempc.autonomy.evaluation import rasterise
 from ridempc.autonomy.global_plan import plan_global
-from ridempc.autonomy.navigate import map_frame
+from ridempc.autonomy.navigate import course_map
 from ridempc.autonomy.navigator import NavigatorSettings, nearby_obstacles
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner
 from ridempc.io import atomic_write_json
@@ -47,11 +46,7 @@ def bench_course(name: str) -> dict[str, Any]:
     """The planners' times on one course [ms]."""
     settings = NavigatorSettings()
     course = resolve_course(name).in_start_frame()
-    frame = map_frame(course)
-    occupied = rasterise(frame, course.obstacles)
-    height = np.full(frame.shape, -np.inf)
-    for box in course.obstacles:
-        height[rasterise(frame, [box])] = box.size[2]
+    frame, occupied, height = course_map(course)
     observed = np.ones(frame.shape, dtype=bool)
     start, goal = np.asarray(course.start[:2]), np.asarray(course.goal)
     plans, heapq_plans = [], []

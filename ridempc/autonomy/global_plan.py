@@ -3,7 +3,8 @@
 The navigator calls :func:`plan_global` at ``global_hz`` and ``ridempc navigate --bench``
 times the same call. The occupied cells are inflated into the costmap; a straddle's cells
 (:mod:`ridempc.autonomy.straddle`) are not obstacles but lethal around them outside their
-lane; the cells never seen cost ``unknown_cost`` more; the search runs on cells
+lane (far specks of low cells neither, :mod:`ridempc.autonomy.straddle_decision`); the
+cells never seen cost ``unknown_cost`` more; the search runs on cells
 ``global_coarsening`` times coarser, and the path is snapped onto the straddles' axes.
 """
 
@@ -18,7 +19,8 @@ from numpy.typing import NDArray
 from ridempc.autonomy.costmap import Costmap, inflate
 from ridempc.autonomy.dijkstra import plan
 from ridempc.autonomy.occupancy import GridFrame
-from ridempc.autonomy.straddle import Straddle, find_straddles, onto_axes, straddle_lethal
+from ridempc.autonomy.straddle import Straddle, onto_axes, straddle_lethal
+from ridempc.autonomy.straddle_decision import StraddleTracker
 from ridempc.autonomy.teb import LOOK_AHEAD
 
 if TYPE_CHECKING:
@@ -37,11 +39,13 @@ class GlobalPlan:
         path: Cell centres (x, y) from the start to the goal [m], shape (n, 2).
         costmap: The (coarsened) costmap it was searched on.
         straddles: The obstacles it passes between the feet, if its path crosses them.
+        ignored: Occupied cells it neither rides round nor straddles (far specks).
     """
 
     path: Array
     costmap: Costmap
     straddles: tuple[Straddle, ...]
+    ignored: NDArray[np.bool_]
 
 
 def plan_global(
@@ -52,6 +56,7 @@ def plan_global(
     start: Array,
     goal: Array,
     settings: NavigatorSettings,
+    tracker: StraddleTracker | None = None,
 ) -> GlobalPlan:
     """The global plan from ``start`` to ``goal`` (x, y) [m] over the map.
 
@@ -63,13 +68,16 @@ def plan_global(
         start: Where the rider is [m].
         goal: The goal [m].
         settings: The navigator's settings.
+        tracker: The ride's straddle decisions so far (None: decided afresh from this map).
 
     Raises:
         NoPath: The goal cannot be reached.
     """
     s = settings
-    straddles = find_straddles(frame, occupied, height, s.straddle, start)
-    obstacles = occupied.copy()
+    tracker = tracker if tracker is not None else StraddleTracker(s.straddle)
+    decision = tracker.update(frame, occupied, height, start)
+    straddles = decision.straddles
+    obstacles = occupied & ~decision.ignored
     for straddle in straddles:
         obstacles &= ~straddle.cells
     costmap = inflate(frame, obstacles, s.inscribed, s.decay)
@@ -81,7 +89,7 @@ def plan_global(
     path = plan(costmap, _free_start(costmap, start), goal)
     # the local goal stays on the axis while the rider is in the lane
     path = onto_axes(path, straddles, s.inscribed + LOOK_AHEAD, lane)
-    return GlobalPlan(path, costmap, straddles)
+    return GlobalPlan(path, costmap, straddles, decision.ignored)
 
 
 def _free_start(costmap: Costmap, start: Array) -> Array:

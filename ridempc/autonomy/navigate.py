@@ -19,11 +19,11 @@ from numpy.typing import NDArray
 
 from ridempc.autonomy.camera import DepthCameraSpec
 from ridempc.autonomy.command_source import SourcedScenario
-from ridempc.autonomy.costmap import inflate
 from ridempc.autonomy.course import Course, resolve_course
 from ridempc.autonomy.depth_sensor import DepthSensor, add_depth_camera
-from ridempc.autonomy.dijkstra import NoPath, plan
+from ridempc.autonomy.dijkstra import NoPath
 from ridempc.autonomy.evaluation import rasterise, score_cells
+from ridempc.autonomy.global_plan import plan_global
 from ridempc.autonomy.judge import CourseJudge
 from ridempc.autonomy.navigator import Navigator, NavigatorSettings
 from ridempc.autonomy.obstacles import add_obstacles, obstacle_geoms, place_obstacles
@@ -41,7 +41,7 @@ from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
 from ridempc.sim.terrain import lay_out_under
 
-__all__ = ["NavigateRequest", "map_frame", "navigate"]
+__all__ = ["NavigateRequest", "check_reachable", "course_map", "map_frame", "navigate"]
 
 Array = NDArray[np.float64]
 
@@ -88,21 +88,36 @@ def map_frame(course: Course, resolution: float = MAP_RESOLUTION) -> GridFrame:
     return GridFrame((float(low[0]), float(low[1])), resolution, (int(shape[0]), int(shape[1])))
 
 
+def course_map(course: Course) -> tuple[GridFrame, NDArray[np.bool_], Array]:
+    """The map a person would give the planner: the course's boxes rasterised on
+    :func:`map_frame`, each cell with its box's height [m] (-inf: free)."""
+    frame = map_frame(course)
+    occupied = rasterise(frame, course.obstacles)
+    height = np.full(frame.shape, -np.inf)
+    for box in course.obstacles:
+        height[rasterise(frame, [box])] = box.size[2]
+    return frame, occupied, height
+
+
 def check_reachable(course: Course, where: str, settings: NavigatorSettings) -> Array:
-    """The global plan over the course's own boxes (its path, shape (n, 2) [m]).
+    """The global plan over the course's own boxes (its path, shape (n, 2) [m]), as the
+    navigator plans it: a box low and narrow enough is a lane between the feet, so a course
+    whose only way is a straddle is reachable.
 
     Raises:
         ConfigError: The goal cannot be reached from the start.
     """
-    frame = map_frame(course)
-    costmap = inflate(frame, rasterise(frame, course.obstacles), settings.inscribed, settings.decay)
-    costmap = costmap.coarsened(settings.global_coarsening)
+    frame, occupied, height = course_map(course)
+    observed = np.ones(frame.shape, dtype=bool)
+    start, goal = np.asarray(course.start[:2]), np.asarray(course.goal)
     try:
-        return plan(costmap, np.asarray(course.start[:2]), np.asarray(course.goal))
+        return plan_global(frame, occupied, height, observed, start, goal, settings).path
     except NoPath as exc:
         raise ConfigError(
             f"{where}: field 'goal' = {list(course.goal)} is unreachable for a rider of radius "
-            f"{settings.inscribed} m ({exc}); allowed: a goal the global planner reaches"
+            f"{settings.inscribed} m, straddling boxes at most {settings.straddle.max_height} m "
+            f"tall and {settings.straddle.max_width} m wide ({exc}); allowed: a goal the "
+            "global planner reaches"
         ) from exc
 
 

@@ -13,6 +13,12 @@ A low obstacle narrow enough to pass between the feet (:mod:`ridempc.autonomy.st
 is not ridden round: the path runs along its axis and the feet are spread around it (the
 wave pattern's lateral offset in the command).
 
+On an incline measured on the map's ground ahead (:mod:`ridempc.autonomy.incline`) the speed
+command holds ``cruise`` and the yaw-rate command is bounded by ``incline_yaw_rate``: gravity
+there moves the riders' speed off their command faster than the command slews, a command cut
+far below the speed makes the MPC rider brake by its ``stop`` manoeuvre, and its turns there
+overshoot their command (both spun it, on the incline and in a turn).
+
 A band that fails ``failures_to_stop`` times in a row, or a goal that becomes unreachable,
 stops the rider (it slows at ``stop_decel`` and holds); the summary records when and why.
 """
@@ -25,12 +31,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.ndimage import binary_dilation
 
 from ridempc.autonomy.camera import CameraIntrinsics
 from ridempc.autonomy.costmap import Costmap
 from ridempc.autonomy.depth_sensor import DepthSensor, mount_pose
 from ridempc.autonomy.dijkstra import NoPath
 from ridempc.autonomy.global_plan import plan_global
+from ridempc.autonomy.incline import incline_ahead
 from ridempc.autonomy.occupancy import GridFrame, OccupancyGrid
 from ridempc.autonomy.perception import Perception
 from ridempc.autonomy.straddle import (
@@ -38,6 +46,7 @@ from ridempc.autonomy.straddle import (
     StraddleSettings,
     lane_walls,
 )
+from ridempc.autonomy.straddle_decision import StraddleTracker
 from ridempc.autonomy.teb import LOOK_AHEAD, TebPlanner, TebSettings
 from ridempc.controllers.base import Controller
 from ridempc.scenarios.scenario import Command
@@ -78,6 +87,20 @@ class NavigatorSettings:
         hold_speed: Largest speed of that hold [m/s], below the MPC's 0.05 m/s of rest.
         failures_to_stop: Band failures in a row that stop the rider.
         obstacle_radius: Map cells within this distance are the band's obstacles [m].
+        incline_hold: On an incline at least this steep [rad] the speed command holds
+            ``cruise`` (no slowing for turns): gravity's pull along the shoes, g sin 3 deg =
+            0.51 m/s^2, is twice ``accel``, so the speed leaves its command faster than the
+            command slews (the MPC rider climbed the slope course at 0.62-0.74 m/s against
+            0.5), and a turn's cut to ``min_speed`` then fell 0.44 m/s below the speed: the
+            MPC rider's ``stop`` manoeuvre, which spun and fell there.
+        incline_reach: The incline is measured this far ahead [m]: the command holds before
+            the shoes reach it (the command horizon and the slew from ``min_speed``,
+            0.5 s + 0.8 s at 0.5 m/s, are 0.65 m).
+        incline_behind: ... and from this far behind the base [m] (the shoes' contact
+            patches behind the pelvis, with the fit's half window).
+        incline_yaw_rate: Largest yaw rate commanded on such an incline [rad/s]: there the
+            MPC rider turned at 2-3 times its command (0.71-1.07 rad/s at 0.35) and spun;
+            at this, thrice is 0.45 rad/s, within the 0.5 rad/s it tracks on the level.
         command_horizon: The command is the band's mean speed and yaw rate over its first
             this many seconds [s] (the riders lag their command by about that much).
         teb: The band's settings.
@@ -103,6 +126,10 @@ class NavigatorSettings:
     hold_speed: float = 0.04
     failures_to_stop: int = 3
     obstacle_radius: float = 2.5
+    incline_hold: float = math.radians(3.0)
+    incline_reach: float = 1.0
+    incline_behind: float = 0.3
+    incline_yaw_rate: float = 0.15
     command_horizon: float = 0.5
     teb: TebSettings = field(default_factory=TebSettings)
     straddle: StraddleSettings = field(default_factory=StraddleSettings)
@@ -150,6 +177,10 @@ class Navigator:
         self._target = (0.0, 0.0)
         self._spread = (0.0, 0.0, 0.0)  # (time, offset, target offset) of the feet [s, m, m]
         self.straddles: tuple[Straddle, ...] = ()
+        self.straddle_tracker = StraddleTracker(s.straddle)
+        # cells that are not the band's obstacles: far specks, and the straddles' cells with
+        # those joining them (a box grows as it is seen, between replans)
+        self._passed = np.zeros(grid.frame.shape, dtype=bool)
         self.straddle_times: list[float] = []  # update times at which the feet were spread
         self._decel = s.accel
         self._failures_in_row = 0
@@ -158,6 +189,8 @@ class Navigator:
         self.stop_reason: str | None = None
         self.band_failures = 0
         self.teb_times: list[float] = []
+        self.incline_times: list[float] = []  # update times at which an incline held the speed
+        self.steepest = 0.0  # steepest incline measured ahead [rad]
         self.global_times: list[float] = []
         self.perception_times: list[float] = []
         self.bands: list[Array] = []
@@ -270,8 +303,22 @@ class Navigator:
         self.bands.append(band.poses)
         v, w = band.command(self.settings.command_horizon)
         self.trace.append((t, v, w, *local_goal))
-        v = max(self.settings.min_speed, min(v, self.settings.cruise))
-        turn = self.settings.turn_at_rest + v / self.settings.turn_radius
+        incline = incline_ahead(
+            self.grid.frame,
+            self.grid.ground,
+            base[:2],
+            yaw,
+            self.settings.incline_reach,
+            self.settings.incline_behind,
+            self.grid.occupied(),
+        )
+        self.steepest = max(self.steepest, incline)
+        s = self.settings
+        on_incline = incline >= s.incline_hold
+        if on_incline:
+            self.incline_times.append(t)
+        v = max(s.cruise if on_incline else s.min_speed, min(v, s.cruise))
+        turn = s.incline_yaw_rate if on_incline else s.turn_at_rest + v / s.turn_radius
         w = float(np.clip(w, -turn, turn))
         self._decel = self.settings.accel
         self._retarget(t, v, w)
@@ -297,6 +344,7 @@ class Navigator:
                 start,
                 self.goal,
                 self.settings,
+                self.straddle_tracker,
             )
         except NoPath as exc:
             self.global_times.append(time.perf_counter() - began)
@@ -304,6 +352,12 @@ class Navigator:
             return False
         self.global_times.append(time.perf_counter() - began)
         self.costmap, self.straddles = planned.costmap, planned.straddles
+        join = round(self.settings.straddle.join / grid.frame.resolution)
+        straddled = np.zeros(grid.frame.shape, dtype=bool)
+        for straddle in planned.straddles:
+            straddled |= straddle.cells
+        reach = np.ones((2 * join + 1, 2 * join + 1), dtype=bool)
+        self._passed = planned.ignored | binary_dilation(straddled, structure=reach)
         self.path = planned.path
         self.paths.append(self.path)
         return True
@@ -326,9 +380,7 @@ class Navigator:
         return np.array([point[0], point[1], math.atan2(d[1], d[0])])
 
     def _nearby_obstacles(self, position: Array) -> Array:
-        obstacles = self.grid.occupied()
-        for straddle in self.straddles:
-            obstacles &= ~straddle.cells
+        obstacles = self.grid.occupied() & ~self._passed
         return nearby_obstacles(self.grid.frame, obstacles, self.straddles, position, self.settings)
 
     def trace_arrays(self) -> dict[str, Array]:
@@ -371,6 +423,8 @@ class Navigator:
                 for st in self.straddles
             ],
             "feet_spread_s": round(len(self.straddle_times) / self.settings.planner_hz, 2),
+            "incline_hold_s": round(len(self.incline_times) / self.settings.planner_hz, 2),
+            "steepest_incline_deg": round(math.degrees(self.steepest), 2),
         }
 
 

@@ -59,6 +59,10 @@ class OccupancyGrid:
         self.observed = np.zeros(frame.shape, dtype=bool)
         # tallest obstacle point seen in each cell over the ground [m]; -inf: none seen
         self.height = np.full(frame.shape, -np.inf)
+        # the ground's height in each cell [m], the last frame's mean of its ground points,
+        # from frames that hit no obstacle in it (a box's lower face reads as ground); NaN:
+        # never seen
+        self.ground = np.full(frame.shape, np.nan)
 
     def update(
         self, sensor: Array, ground: Array, obstacles: Array, heights: Array | None = None
@@ -76,10 +80,12 @@ class OccupancyGrid:
         hit = np.zeros(frame.shape, dtype=bool)
         ij, inside = self._ray_cells(sensor, ground)  # a ray to an obstacle clears no floor
         free[ij[inside, 0], ij[inside, 1]] = True
-        ij, inside = frame.cells(ground[:, :2])
-        free[ij[inside, 0], ij[inside, 1]] = True
         ij, inside = frame.cells(obstacles[:, :2])
         hit[ij[inside, 0], ij[inside, 1]] = True
+        on, below = frame.cells(ground[:, :2])
+        free[on[below, 0], on[below, 1]] = True
+        below[below] &= ~hit[on[below, 0], on[below, 1]]
+        self._fuse_ground(on[below], ground[below, 2])
         if heights is not None:
             np.maximum.at(self.height, (ij[inside, 0], ij[inside, 1]), heights[inside])
         free &= ~hit
@@ -87,6 +93,14 @@ class OccupancyGrid:
         self.log_odds[hit] += L_OCCUPIED
         np.clip(self.log_odds, L_MIN, L_MAX, out=self.log_odds)
         self.observed |= free | hit
+
+    def _fuse_ground(self, ij: NDArray[np.int64], z: Array) -> None:
+        """Each cell's ground height [m] from this frame's ground points in it."""
+        flat = np.ravel_multi_index((ij[:, 0], ij[:, 1]), self.frame.shape)
+        count = np.bincount(flat, minlength=self.ground.size)
+        total = np.bincount(flat, weights=z, minlength=self.ground.size)
+        seen = count > 0
+        self.ground.reshape(-1)[seen] = total[seen] / count[seen]
 
     def _ray_cells(
         self, sensor: Array, points: Array

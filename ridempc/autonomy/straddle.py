@@ -1,13 +1,14 @@
 """The wave pattern chosen by the planner: a low, narrow obstacle passed between the feet.
 
 The Hovershoes paper passes a short obstacle by splitting the feet around it (its wave
-pattern); a person decided when. Here the map decides: each connected group of occupied
-cells is measured along and across its principal axis, and a group no taller than
+pattern); a person decided when. Here the map decides: each group of occupied cells (cells
+up to ``join`` apart) is measured along and across its principal axis, and a group no taller than
 ``max_height`` over the ground and no wider than ``max_width`` across that axis is a
 *straddle*. For the planners it stops being an obstacle and becomes a lane: the rider's
 centre may come within the inscribed radius of it only inside a band of half-width
 ``lane`` about its axis, so the path that crosses it runs along the axis, the box between
-the shoes. While the rider is in that lane, from ``lead`` before the box to past it, the
+the shoes (:mod:`ridempc.autonomy.straddle_decision` keeps the decision across replans).
+While the rider is in that lane, from ``lead`` before the box to past it, the
 command spreads each foot ``spread`` further out (the wave scenario's widest stance).
 """
 
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.ndimage import distance_transform_edt, label
+from scipy.ndimage import binary_dilation, distance_transform_edt, label
 
 from ridempc.autonomy.occupancy import GridFrame
 
@@ -26,7 +27,10 @@ __all__ = [
     "Straddle",
     "StraddleSettings",
     "find_straddles",
+    "fits",
+    "group_cells",
     "lane_walls",
+    "measure_groups",
     "onto_axes",
     "straddle_lethal",
 ]
@@ -60,6 +64,20 @@ class StraddleSettings:
         look_ahead: The local goal's distance along the path while straddling [m]: the
             rider closes a lateral error over about this distance, and 1.75 m (the
             paper's) let the MPC rider drift 7 cm off the axis over the 0.6 m box.
+        join: Cells up to this far apart are one group [m]: a box's top and faces are
+            seen a cell apart where the depth noise leaves a cell unhit (a lone cell
+            inside the straddle course's box, taken for an obstacle of its own, sent the
+            path round it); two 5 cm cells, narrower than any gap a rider passes.
+        decide_range: A group is decided (straddle or obstacle) once the rider is this
+            close to it [m]: the depth's sigma, 0.004 z^2, is 0.025 m here (0.036 m at
+            the 3 m fusing range), a quarter of the margin between a 0.1 m box's measured
+            top and ``max_height``; beyond it a low group is taken as a straddle, a
+            speck of fewer than ``min_cells`` neither straddled nor ridden round.
+        height_margin: A decided straddle stays one until measured this much taller
+            than ``max_height`` [m] (hysteresis: twice the depth's sigma at the
+            deciding range, so a top that noise lifts as frames fuse does not flip it).
+        width_margin: ... and this much wider than ``max_width`` [m] (a cell of speckle
+            at each side).
     """
 
     max_height: float = 0.2
@@ -70,6 +88,10 @@ class StraddleSettings:
     spread_rate: float = 0.1
     look_ahead: float = 0.8
     min_cells: int = 4
+    join: float = 0.1
+    decide_range: float = 2.5
+    height_margin: float = 0.05
+    width_margin: float = 0.1
 
 
 @dataclass(frozen=True)
@@ -112,11 +134,9 @@ def find_straddles(
     settings: StraddleSettings,
     rider: Array,
 ) -> tuple[Straddle, ...]:
-    """The groups of occupied cells (8-connected) low and narrow enough to straddle.
-
-    A group is measured along its two principal axes; of those across which it is narrow
-    enough, the one pointing most nearly from the rider to it is the axis it is ridden
-    along (a box seen only by its front face is narrow both ways).
+    """The groups of occupied cells low and narrow enough to straddle, decided afresh from
+    this one map (no memory: :class:`~ridempc.autonomy.straddle_decision.StraddleTracker`
+    keeps one across replans).
 
     Args:
         frame: The grid's geometry.
@@ -126,18 +146,63 @@ def find_straddles(
         settings: What can be straddled.
         rider: The rider's position (x, y) [m].
     """
-    labels, count = label(occupied, structure=np.ones((3, 3), dtype=bool))
+    return tuple(
+        group
+        for group in measure_groups(
+            frame, occupied, height, settings, rider, settings.max_height, settings.max_width
+        )
+        if fits(group, settings.max_height, settings.max_width, settings.min_cells)
+    )
+
+
+def fits(group: Straddle, max_height: float, max_width: float, min_cells: int) -> bool:
+    """Whether a measured group is at most ``max_height`` tall and ``max_width`` wide [m]
+    and holds at least ``min_cells`` cells."""
+    return (
+        group.height <= max_height
+        and 2.0 * group.half_width <= max_width
+        and int(group.cells.sum()) >= min_cells
+    )
+
+
+def group_cells(occupied: NDArray[np.bool_], join: int) -> tuple[NDArray[np.int32], int]:
+    """Labels of the groups of occupied cells: cells up to ``join`` free cells apart are
+    one group (a box's faces seen with a gap are one box), and the group's count."""
+    reach = np.ones((2 * join + 1, 2 * join + 1), dtype=bool)
+    joined = binary_dilation(occupied, structure=reach) if join > 0 else occupied
+    labels, count = label(joined, structure=np.ones((3, 3), dtype=bool))
+    labels[~occupied] = 0
+    return labels, int(count)
+
+
+def measure_groups(
+    frame: GridFrame,
+    occupied: NDArray[np.bool_],
+    height: Array,
+    settings: StraddleSettings,
+    rider: Array,
+    tallest: float,
+    widest: float,
+) -> tuple[Straddle, ...]:
+    """The groups of occupied cells (:func:`group_cells`, ``settings.join`` apart) no taller
+    than ``tallest`` [m], each measured along and across its principal axes.
+
+    Of the axes across which a group is at most ``widest`` [m] wide, the one pointing most
+    nearly from the rider to it is the axis it would be ridden along (a box seen only by
+    its front face is narrow both ways); across neither: the narrower.
+    """
+    labels, count = group_cells(occupied, round(settings.join / frame.resolution))
     if count == 0:
         return ()
     measured = np.where(np.isfinite(height), height, np.inf)  # none seen: not known low
-    tallest = np.zeros(count + 1)
-    np.maximum.at(tallest, labels[occupied], measured[occupied])
-    sizes = np.bincount(labels[occupied], minlength=count + 1)
+    top = np.zeros(count + 1)
+    np.maximum.at(top, labels[occupied], measured[occupied])
     found = []
     r = frame.resolution
-    low = (tallest <= settings.max_height) & (sizes >= settings.min_cells)
-    for k in np.nonzero(low[1:])[0] + 1:
+    for k in np.nonzero(top[1:] <= tallest)[0] + 1:
         i, j = np.nonzero(labels == k)
+        if len(i) == 0:
+            continue
         xy = np.column_stack([frame.origin[0] + (i + 0.5) * r, frame.origin[1] + (j + 0.5) * r])
         center = xy.mean(axis=0)
         if len(xy) > 1:
@@ -145,7 +210,7 @@ def find_straddles(
         else:
             vectors = np.eye(2)
         approach = center - np.asarray(rider, dtype=float)
-        best: tuple[float, Array, float, float] | None = None
+        best: tuple[tuple[bool, float], Array, float, float] | None = None
         for axis in (vectors[:, 1], vectors[:, 0]):
             normal = np.array([-axis[1], axis[0]])
             along, across = (xy - center) @ axis, (xy - center) @ normal
@@ -155,11 +220,12 @@ def find_straddles(
             # made a box 0.35 m wide for a moment, and the path went round) does not count
             half_width = 0.5 * float(np.subtract(*np.percentile(across, [95, 5]))) + pad
             half_length = 0.5 * float(np.subtract(*np.percentile(along, [95, 5]))) + pad
-            alignment = abs(float(axis @ approach))
-            if 2.0 * half_width <= settings.max_width and (best is None or alignment > best[0]):
-                best = (alignment, axis, half_length, half_width)
-        if best is None:
-            continue
+            # narrow enough first, then the most aligned with the approach (else the narrower)
+            narrow = 2.0 * half_width <= widest
+            rank = (narrow, abs(float(axis @ approach)) if narrow else -half_width)
+            if best is None or rank > best[0]:
+                best = (rank, axis, half_length, half_width)
+        assert best is not None
         _, axis, half_length, half_width = best
         found.append(
             Straddle(
@@ -168,7 +234,7 @@ def find_straddles(
                 axis=axis,
                 half_length=half_length,
                 half_width=half_width,
-                height=float(tallest[k]),
+                height=float(top[k]),
             )
         )
     return tuple(found)
