@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from ridempc.mpc.divergence import GRAVITY, DivergentDeviation
+from ridempc.mpc.divergence import GRAVITY, DivergentDeviation, Probation
 
 STEP = 1.0 / 30.0  # [s] the MPC's tick
 HEIGHT = 0.9  # [m] a standing rider's centre of mass over its feet
@@ -58,3 +58,14 @@ def test_reset_forgets_the_plan_and_an_uncounted_update_is_no_peak() -> None:
     divergence.reset()
     assert divergence.update(10.0, 5.0, HEIGHT, counted=False) == pytest.approx(5.0)
     assert divergence.peak == peak
+
+
+def test_probation_ends_after_a_dwell_fit_and_restarts_on_a_return() -> None:
+    probation = Probation()
+    assert not probation.update(0.0, True, 0.5)
+    assert not probation.update(0.3, False, 0.5)  # unfit: the dwell starts again
+    assert not probation.update(0.4, True, 0.5)
+    assert probation.update(0.9, True, 0.5)
+    assert probation.update(1.0, False, 0.5)  # once proven, until restarted
+    probation.restart()
+    assert not probation.proven

@@ -72,8 +72,9 @@ has no solution as posed, :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (it
 previous plan shifted by one step is then used), the whole-body QP needs slack or still
 fails, anything raises, the estimate is not finite, or the state strays beyond
 :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, or will be within a
-divergence time at the rate it grows beyond what its plan expects
-(:mod:`~ridempc.mpc.divergence`), the ride is handed to
+divergence time at the rate it grows beyond what its plan expects, until the MPC has held
+the rider settled since the start or its last return (:mod:`~ridempc.mpc.divergence`),
+the ride is handed to
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
@@ -103,13 +104,14 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.divergence import DivergentDeviation
+from ridempc.mpc.divergence import DivergentDeviation, Probation
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.handover import (
     HANDOVER_DEVIATION,
     RETURN_DEVIATION,
+    RETURN_DWELL_S,
     STANDBY_DIVIDER,
     Handover,
     deviation,
@@ -501,6 +503,7 @@ class MpcRider(Controller):
         self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
         self._divergence = DivergentDeviation()  # where that deviation is heading
+        self._probation = Probation()  # whether the MPC has shown its model holds the rider
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
@@ -622,7 +625,7 @@ class MpcRider(Controller):
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
         if self._deviation > HANDOVER_DEVIATION:
             return out, f"state {self._deviation:.2g} of its tolerances from the reference"
-        if self._divergence.value > HANDOVER_DEVIATION:
+        if not self._probation.proven and self._divergence.value > HANDOVER_DEVIATION:
             return out, (
                 f"state {self._deviation:.2g} of its tolerances from the reference, "
                 f"growing at {self._divergence.rate:.2g}/s"
@@ -856,6 +859,11 @@ class MpcRider(Controller):
         riding = not self.handover.on_backup  # the peak is the MPC's own rides'
         self._divergence.update(solve.time, built.deviation, self._com_height, riding)
         self._divergence.expect(built.expected)
+        if riding:
+            settled = not plan.fallback and built.deviation <= RETURN_DEVIATION
+            self._probation.update(solve.time, settled, RETURN_DWELL_S)
+        else:
+            self._probation.restart()
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
