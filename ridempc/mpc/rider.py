@@ -507,9 +507,13 @@ class MpcRider(Controller):
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
+        # the backup's standby in full every tick while the MPC is on probation, where an
+        # early handover is likely: at 33 Hz over the first 0.06 s its filters had not caught
+        # up, and handed the ride it fell where it stands alone (hard seed 7 v0004)
+        self._standby_every = STANDBY_DIVIDER if shared else 1
         self.handover = Handover(
             law,
-            standby_every=STANDBY_DIVIDER if shared else 1,
+            standby_every=1,
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
         self._diagnostics: dict[str, float] = {}
@@ -864,6 +868,7 @@ class MpcRider(Controller):
             self._probation.update(solve.time, settled, RETURN_DWELL_S)
         else:
             self._probation.restart()
+        self.handover.standby_every = self._standby_every if self._probation.proven else 1
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
