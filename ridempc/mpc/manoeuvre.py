@@ -23,7 +23,10 @@ The motion library holds manoeuvres from rest or between steady speeds (``accele
   stride from the rolling board back up to it (:meth:`ManoeuvreSelector.repush`), and
   coasts again at its end;
 - **stop** when the command returns to zero, where the library has ``stop`` entries (the
-  skateboard has none: it coasts on, four-leg balancing); also to **slow down** while the
+  skateboard has none: it coasts on, four-leg balancing); also to **ride out a push** that
+  leaves a rider holding still more than ``RETARGET_BAND`` faster than rest (the stop from
+  her speed: the board carries her on and brakes as the library found feasible, as the PD
+  lets it, where rest held at once fought the push); and to **slow down** while the
   rider is more than ``RETARGET_BAND`` faster than a commanded speed that is not rest: the
   stop from the rider's speed, started at its phase, brakes as the library found feasible,
   and once the rider is down to the command the ``accelerate`` entry of that speed rides
@@ -241,6 +244,8 @@ class ManoeuvreSelector:
         """
         wanted = command.velocity
         if wanted < MOVING:
+            if current.kind == HOLD and "stop" in self.targets and speed > RETARGET_BAND:
+                return Manoeuvre("stop", self._clamped("stop", speed), now)  # pushed: ride out
             if current.kind in (HOLD, "stop") or "stop" not in self.targets:
                 return current
             return Manoeuvre("stop", self._clamped("stop", max(speed, current.target)), now)

@@ -73,7 +73,10 @@ Every 2 ms (500 Hz) the rider
 has no solution as posed, :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its
 previous plan shifted by one step is then used), the whole-body QP needs slack or still
 fails, anything raises, the estimate is not finite, or the state strays beyond
-:data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, the ride is handed to
+:data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, or will be within a
+divergence time at the rate it grows beyond what its plan expects, until the MPC has held
+the rider settled since the start or its last return (:mod:`~ridempc.mpc.divergence`),
+the ride is handed to
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
@@ -105,12 +108,14 @@ from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.delay import predicted_start
 from ridempc.mpc.disturbance import DisturbanceObserver, disturbance_rows
+from ridempc.mpc.divergence import DivergentDeviation, Probation
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.handover import (
     HANDOVER_DEVIATION,
     RETURN_DEVIATION,
+    RETURN_DWELL_S,
     STANDBY_DIVIDER,
     Handover,
     deviation,
@@ -216,7 +221,8 @@ class _Built(NamedTuple):
     """An MPC problem built and solved (:meth:`MpcRider._build_and_run`): its plan, the
     contacts of its first step, the time spent building it [s], the QP's failures so far,
     the problem (None when sent back from the solver process without it) and how far its
-    initial state lies from its reference (:func:`~ridempc.mpc.handover.deviation`) [-]."""
+    initial state lies from its reference (:func:`~ridempc.mpc.handover.deviation`) and how
+    far its plan's next state lies from the next reference [-]."""
 
     plan: Plan
     contacts: tuple[Contact, ...]
@@ -224,6 +230,7 @@ class _Built(NamedTuple):
     failures: int
     problem: MpcProblem | None
     deviation: float
+    expected: float
 
 
 class _PendingSolve(NamedTuple):
@@ -510,11 +517,18 @@ class MpcRider(Controller):
         self._wbc_ms: list[float] = []
         self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
+        self._divergence = DivergentDeviation()  # where that deviation is heading
+        self._probation = Probation()  # whether the MPC has shown its model holds the rider
+        self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
+        # the backup's standby in full every tick while the MPC is on probation, where an
+        # early handover is likely: at 33 Hz over the first 0.06 s its filters had not caught
+        # up, and handed the ride it fell where it stands alone (hard seed 7 v0004)
+        self._standby_every = STANDBY_DIVIDER if shared else 1
         self.handover = Handover(
             law,
-            standby_every=STANDBY_DIVIDER if shared else 1,
+            standby_every=1,
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
         self._diagnostics: dict[str, float] = {}
@@ -626,7 +640,8 @@ class MpcRider(Controller):
         """The MPC and whole-body QP's command this tick (None where they have none), and
         why they cannot ride (None if they can): the estimate not finite, a plan or a QP
         that failed, a QP that needed slack (:mod:`ridempc.wbc.elastic`), or the state
-        beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference."""
+        beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, now or a
+        divergence time on (:mod:`~ridempc.mpc.divergence`)."""
         estimate = self.estimator.state
         if estimate is None or not (
             np.isfinite(estimate.q).all() and np.isfinite(estimate.v).all()
@@ -657,19 +672,28 @@ class MpcRider(Controller):
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
         if self._deviation > HANDOVER_DEVIATION:
             return out, f"state {self._deviation:.2g} of its tolerances from the reference"
+        if not self._probation.proven and self._divergence.value > HANDOVER_DEVIATION:
+            return out, (
+                f"state {self._deviation:.2g} of its tolerances from the reference, "
+                f"growing at {self._divergence.rate:.2g}/s"
+            )
         return out, None
 
     def _fit(self) -> bool:
         """Whether the MPC may ride again: its plan solved (not the last one shifted) and
-        the state near its reference (:func:`~ridempc.mpc.handover.deviation`)."""
+        the state near its reference (:func:`~ridempc.mpc.handover.deviation`) and not
+        heading away from it faster than planned (:mod:`~ridempc.mpc.divergence`)."""
         plan = self._plan
-        return plan is not None and not plan.fallback and self._deviation <= RETURN_DEVIATION
+        settled = max(self._deviation, self._divergence.value) <= RETURN_DEVIATION
+        return plan is not None and not plan.fallback and settled
 
     def hold_speed(self) -> None:
         self.selector.holds_speed = True  # the library's ``repush`` entries, where it has them
 
     def _mpc_tick(self, estimate: EstimatedState, command: Command, now: float) -> None:
         speed = self._speed(estimate)
+        feet = np.asarray(estimate.foot_position, dtype=float)
+        self._com_height = float(self.map.com(estimate)[2] - feet[:, 2].mean())
         # The manoeuvre is chosen, and its phase matched, on the CoM's speed, which the
         # reference's ``vx`` is: read off the feet, a Segway's speed swung +-0.3 m/s about
         # the rider's at 3-4 m/s, and one swing started the 4 m/s push 0.36 m/s ahead of
@@ -681,6 +705,8 @@ class MpcRider(Controller):
         if wanted is self.manoeuvre and self._coasting(self.manoeuvre.reference_time(now)):
             wanted = self.selector.repush(command, wanted, now, speed)  # slowed: push again
         began = wanted is not self.manoeuvre
+        if began:
+            self._divergence.reset()  # a new reference: its deviation steps, no divergence
         if began:
             self.mpc.retarget(wanted.library_kind, wanted.target)
             if wanted.kind == REPUSH and self.push_side is not None:
@@ -820,8 +846,10 @@ class MpcRider(Controller):
         build = time.perf_counter() - started
         qp = self.mpc.qp
         plan = qp.finish(qp.start(problem), qp.run())
-        gap = deviation(problem.initial_state, problem.state_reference[0], problem.state_weights)
-        return _Built(plan, problem.contacts[0], build, qp.failures, problem, gap)
+        weights, reference = problem.state_weights, problem.state_reference
+        gap = deviation(problem.initial_state, reference[0], weights)
+        expected = deviation(plan.states[1], reference[1], weights)
+        return _Built(plan, problem.contacts[0], build, qp.failures, problem, gap, expected)
 
     def _build_in_process(self, inputs: _BuildInputs) -> _Built:
         """:meth:`_build_and_run` in the solver process, its reply without the problem
@@ -903,6 +931,15 @@ class MpcRider(Controller):
         self._mpc_failures = built.failures
         self._deviation = built.deviation
         self._diagnostics["mpc_deviation"] = built.deviation
+        riding = not self.handover.on_backup  # the peak is the MPC's own rides'
+        self._divergence.update(solve.time, built.deviation, self._com_height, riding)
+        self._divergence.expect(built.expected)
+        if riding:
+            settled = not plan.fallback and built.deviation <= RETURN_DEVIATION
+            self._probation.update(solve.time, settled, RETURN_DWELL_S)
+        else:
+            self._probation.restart()
+        self.handover.standby_every = self._standby_every if self._probation.proven else 1
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
@@ -1258,6 +1295,7 @@ class MpcRider(Controller):
         out["wbc_elastic_solves"] = self.wbc.qp.elastic_solves
         out["wbc_slack_max"] = self._wbc_slack_max
         out["fallbacks"] = self.handover.summary()
+        out["deviation_divergent_max"] = self._divergence.peak
         out["safe_hold"] = (
             None
             if self._hold_reason is None
