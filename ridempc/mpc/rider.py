@@ -127,6 +127,7 @@ from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_gain import shifted_speeds
+from ridempc.mpc.push_level import touchdown_ease
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.riding_posture import ride_qpos
@@ -674,8 +675,12 @@ class MpcRider(Controller):
         balancing = self.manoeuvre.kind == HOLD or coasting
         self._absorb_payload(estimate, balancing)
         pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
-        if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
+        if balancing:
             roll = roll + self._steering_roll(command, now, speed)
+        elif self.manoeuvre.kind == REPUSH and not pushing:  # level by the touchdown
+            nodes = t_ref + self.mpc.settings.dt * np.arange(len(roll), dtype=np.float64)
+            eased = touchdown_ease(self.mpc.reference, nodes)
+            roll = roll + eased * self._steering_roll(command, now, speed)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
