@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ridempc.mpc.push_level import EASE, touchdown_ease
+from ridempc.mpc.push_level import EASE, eased_roll, touchdown_ease
 from ridempc.mpc.reference import select_reference
 from ridempc.trajopt.schedule import Contact
 
@@ -31,3 +31,12 @@ def test_the_deck_is_level_on_the_ground_and_steers_again_before_and_after() -> 
     np.testing.assert_allclose(after, [1.0, 1.0])  # no touchdown ahead: steered again
     between = touchdown_ease(reference, np.array([lift + 0.05]))
     assert between[0] == pytest.approx(min(1.0, (land2 - lift - 0.05) / EASE))
+
+
+def test_only_the_roll_that_raises_the_pushing_foot_is_eased() -> None:
+    steering = np.array([0.1, -0.1, 0.05])  # positive: the right edge down
+    share = np.array([0.5, 0.5, 0.0])
+    # a right foot (-1) rises with the left edge down: negative rolls eased
+    np.testing.assert_allclose(eased_roll(steering, share, -1.0), [0.1, -0.05, 0.05])
+    np.testing.assert_allclose(eased_roll(steering, share, 1.0), [0.05, -0.1, 0.0])
+    np.testing.assert_allclose(eased_roll(steering, share, None), [0.05, -0.05, 0.0])

@@ -10,7 +10,10 @@ with 0-18 N instead of the entry's 32-36 N, its friction pyramid let it push for
 regained 0.16 (seed 0, the first push). So the steering roll is eased out over the last
 :data:`EASE` of each swing towards the ground, node by node over the MPC's horizon: the deck
 is level, and the weight back over the pushing side, when the foot lands (the same push then
-regained 0.10 m/s); after the last push it steers again.
+regained 0.10 m/s); after the last push it steers again. Only the roll that *raises* the
+pushing foot's edge is eased (:func:`eased_roll`): one that lowers it, as when a turn has
+changed sides since the push's foot was chosen (``yaw-steps-hold``), already leans the rider
+onto that foot, and easing it too left a swing unsteered before an alternating turn.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from numpy.typing import NDArray
 from ridempc.mpc.reference import MotionReference
 from ridempc.trajopt.schedule import Contact
 
-__all__ = ["EASE", "touchdown_ease"]
+__all__ = ["EASE", "eased_roll", "touchdown_ease"]
 
 Array = NDArray[np.float64]
 
@@ -57,3 +60,20 @@ def touchdown_ease(reference: MotionReference, times: Array, ease: float = EASE)
     share = np.clip(ahead / max(ease, 1e-9), 0.0, 1.0)
     share[on_ground] = 0.0
     return share
+
+
+def eased_roll(steering: Array, share: Array, side: float | None) -> Array:
+    """The steering roll ``steering`` [rad] at the horizon's nodes with the part that raises
+    the pushing foot's edge scaled by ``share`` (:func:`touchdown_ease`).
+
+    Args:
+        steering: The steering roll at each node [rad] (positive: the right edge down).
+        share: The share kept at each node [-].
+        side: The pushing foot's side (+1 left, -1 right), or None where it is not known
+            (every roll eased).
+    """
+    steering = np.asarray(steering, dtype=np.float64)
+    if side is None:
+        return share * steering
+    raises = steering * side > 0.0  # a left foot's edge rises with the right edge down
+    return np.where(raises, share * steering, steering)
