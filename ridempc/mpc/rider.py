@@ -127,7 +127,6 @@ from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_gain import shifted_speeds
-from ridempc.mpc.push_level import eased_roll, touchdown_ease
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.riding_posture import ride_qpos
@@ -675,13 +674,8 @@ class MpcRider(Controller):
         balancing = self.manoeuvre.kind == HOLD or coasting
         self._absorb_payload(estimate, balancing)
         pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
-        if balancing:
+        if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
             roll = roll + self._steering_roll(command, now, speed)
-        elif self.manoeuvre.kind == REPUSH and not pushing:  # level by the touchdown
-            nodes = t_ref + self.mpc.settings.dt * np.arange(len(roll), dtype=np.float64)
-            share = touchdown_ease(self.mpc.reference, nodes)
-            side = self.push_side.last if self.push_side is not None else None
-            roll = roll + eased_roll(self._steering_roll(command, now, speed), share, side)
         roll = self._stance_roll(roll, estimate, now, balancing)
         turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
