@@ -102,11 +102,13 @@ def test_path_metrics_from_a_log() -> None:
 
 
 def test_the_steering_scenarios_load() -> None:
-    for name in ("yaw-steps", "yaw-steps-hold", "circle", "slalom"):
+    for name in ("yaw-steps", "yaw-steps-hold", "circle", "slalom", "circle-hold"):
         scenario = resolve_scenario(name, "skateboard")
         assert scenario.boards == ("skateboard",)
     held = resolve_scenario("yaw-steps-hold", "skateboard").push_off
     assert held is not None and held.hold  # pushed again while rolling
+    circle = resolve_scenario("circle-hold", "skateboard")
+    assert circle.push_off is not None and circle.push_off.hold and circle.path is not None
     assert not resolve_scenario("push-off-0.5", "skateboard").push_off.hold  # type: ignore[union-attr]
     assert resolve_scenario("circle", "skateboard").path.radius == 3.0  # type: ignore[union-attr]
 
