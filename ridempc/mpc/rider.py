@@ -175,6 +175,11 @@ MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step
 # The law the ride is handed to when the MPC or its QP fails (ridempc.mpc.handover): the
 # pair's PD baseline, which balances every pair from the same sensors.
 BACKUP_LAW: str = "pd"
+# [s] how long from the ride's start the backup's standby runs every tick while the MPC is
+# on probation: an unknown model (a payload's offset) tips the rider within 0.5-1 s of the
+# start, where the backup's filters are still settling from rest; later its 33 Hz standby
+# keeps them current (every tick throughout cost 8 % of the loop's speed).
+STANDBY_WARMUP_S: float = 1.0
 # Least plan_latency [ticks] whose solves go to the solver process: at 1 the loop takes the
 # plan up after the next tick's simulation and estimate, about 0.5 ms after sending the
 # state, where the process builds and solves in 2.3 ms (Hovershoes, median) and the thread,
@@ -522,9 +527,9 @@ class MpcRider(Controller):
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
-        # the backup's standby in full every tick while the MPC is on probation, where an
-        # early handover is likely: at 33 Hz over the first 0.06 s its filters had not caught
-        # up, and handed the ride it fell where it stands alone (hard seed 7 v0004)
+        # the backup's standby in full every tick while the MPC is on its first probation, in
+        # the ride's first STANDBY_WARMUP_S: the backup's filters start there from rest, and
+        # at 33 Hz over the first 0.06 s they had not caught up when handed the ride
         self._standby_every = STANDBY_DIVIDER if shared else 1
         self.handover = Handover(
             law,
@@ -939,7 +944,8 @@ class MpcRider(Controller):
             self._probation.update(solve.time, settled, RETURN_DWELL_S)
         else:
             self._probation.restart()
-        self.handover.standby_every = self._standby_every if self._probation.proven else 1
+        warming = not self._probation.proven and solve.time < STANDBY_WARMUP_S
+        self.handover.standby_every = 1 if warming else self._standby_every
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
