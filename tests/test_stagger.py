@@ -63,5 +63,8 @@ def test_the_handover_runs_the_standby_on_its_phase() -> None:
 def test_the_rider_staggers_its_standby(latency: int) -> None:
     rider = MpcRider(load_robot("cassie"), "hovershoes", plan_latency=latency)
     handover = rider.handover
-    assert handover.standby_every == STANDBY_DIVIDER and handover.blend_s == BLEND_S
+    # in full every tick over the ride's first second on probation (its filters settle from
+    # rest), then every STANDBY_DIVIDER-th tick
+    assert handover.standby_every == 1 and handover.blend_s == BLEND_S
+    assert rider._standby_every == STANDBY_DIVIDER
     assert handover.standby_phase == standby_phase(MPC_DIVIDER, latency)
