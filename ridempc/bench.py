@@ -45,7 +45,10 @@ For each robot-board pair with a pair file (:func:`ridempc.mpc.pairs.mpc_pair_na
 The JSON's ``controller_tick_p99_ms`` is the p99 of the rider's whole update per control
 tick (estimator, MPC share, WBC and the rest), ``mpc_tick_p99_ms`` the MPC tick's (build
 and solve), ``controller_physics_ratio`` the rider's wall time over the simulation's in the
-same ride and ``reference_ms`` the machine reference. With ``profile`` (``--profile``) the
+same ride and ``reference_ms`` the machine reference; ``tick_phases_ms`` sorts the
+controller ticks by their place in the MPC's period (:mod:`ridempc.tickphases`: the MPC's
+tick, the plan's take-up and the backup's standby each have one, so the controller tick's
+p99 is theirs; ``steady_p99`` is the other ticks'). With ``profile`` (``--profile``) the
 pair rides once more under :class:`~ridempc.tickprofile.PartProfiler`, and ``profile``
 lists each part's hottest functions by their own time.
 
@@ -79,6 +82,7 @@ from ridempc.heap import frozen_heap
 from ridempc.interrupts import casadi_solve, osqp_returned
 from ridempc.io import atomic_write_json
 from ridempc.solvers import QP_KINDS, solve_dense
+from ridempc.tickphases import tick_phases
 from ridempc.tickprofile import DEFAULT_TOP, PartProfiler, profile_table
 
 __all__ = ["PairBench", "bench", "bench_table"]
@@ -104,6 +108,7 @@ class PairBench:
     mpc_tick_p99_ms: float = float("nan")
     controller_tick_p99_ms: float = float("nan")
     controller_physics_ratio: float = float("nan")
+    tick_phases_ms: dict[str, float] = field(default_factory=dict)
     wbc_solve_median_ms: float = float("nan")
     wbc_solve_p99_ms: float = float("nan")
     mpc_solve_best_p99_ms: float = float("nan")
@@ -563,6 +568,7 @@ def bench_pair(
     out.mpc_tick_median_ms, out.mpc_tick_p99_ms = _stats([1e-3 * ms for ms in rider.mpc_tick_ms])
     out.controller_tick_p99_ms = _stats(result.controller_times.tolist())[1]
     out.controller_physics_ratio = _controller_physics_ratio(result)
+    out.tick_phases_ms = _tick_phases(rider, result.controller_times)
     if profile:
         profiler = PartProfiler(BUDGET_PARTS)
         profiled = _record(robot, board, out.scenario, seconds, wbc_solver, profiler)[0]
@@ -582,6 +588,22 @@ def bench_pair(
         out.wbc_solve_best_p99_ms = _best_p99(passes)
         out.wbc_solvers = _other_wbc_solvers(rider, solved, wbc_solver)
     return out
+
+
+def _tick_phases(rider: Any, seconds: Any) -> dict[str, float]:
+    """The controller ticks by their place in the MPC's period
+    (:func:`~ridempc.tickphases.tick_phases`): the MPC's tick, the plan's take-up (its own
+    tick from a ``plan_latency`` of one on) and the backup's standby, after the ride's
+    first :data:`~ridempc.mpc.rider.STANDBY_WARMUP_S` (the standby there runs every tick)."""
+    from ridempc.mpc.rider import MPC_DIVIDER, STANDBY_WARMUP_S
+
+    handover = rider.handover
+    periodic = {
+        "mpc_tick": 0,
+        "take_up": rider.plan_latency or None,
+        "standby": handover.standby_phase if handover.standby_every == MPC_DIVIDER else None,
+    }
+    return tick_phases(seconds, MPC_DIVIDER, periodic, rider.rate_hz, STANDBY_WARMUP_S)
 
 
 def _controller_physics_ratio(result: Any) -> float:
@@ -733,17 +755,23 @@ def bench_table(rows: Sequence[PairBench]) -> str:
 
 
 def _budget_table(rows: Sequence[PairBench]) -> list[str]:
-    """The closed loop's budget: mean wall time per 2 ms control tick [ms], by part."""
+    """The closed loop's budget: mean wall time per 2 ms control tick [ms], by part; the
+    periodic ticks' medians and the other ticks' p99 (:mod:`ridempc.tickphases`)."""
     head = " | ".join(BUDGET_PARTS)
     lines = [
         "",
-        f"| pair | mean per control tick [ms]: loop | {head} | machine reference [ms] |",
+        f"| pair | mean per control tick [ms]: loop | {head} | machine reference [ms] | "
+        "median tick [ms]: MPC / take-up / standby | other ticks' p99 [ms] |",
     ]
-    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS) + "---|")
+    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS) + "---|---|---|")
     for r in rows:
-        b = r.budget_ms
+        b, phases = r.budget_ms, r.tick_phases_ms
         cells = " | ".join(_ms(b.get(k, float("nan"))) for k in ("loop", *BUDGET_PARTS))
-        lines.append(f"| {r.pair} | {cells} | {_ms(r.reference_ms)} |")
+        periodic = " / ".join(
+            _ms(phases.get(f"{k}_median", float("nan"))) for k in ("mpc_tick", "take_up", "standby")
+        )
+        steady = _ms(phases.get("steady_p99", float("nan")))
+        lines.append(f"| {r.pair} | {cells} | {_ms(r.reference_ms)} | {periodic} | {steady} |")
     return lines
 
 

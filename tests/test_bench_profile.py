@@ -24,6 +24,9 @@ def test_the_json_holds_the_tick_figures_and_the_profile(tmp_path: Path) -> None
         "reference_ms",
     ):
         assert isinstance(row[key], float) and row[key] > 0.0, key
+    assert {"mpc_tick_median", "take_up_median", "standby_median", "steady_p99"} <= set(
+        row["tick_phases_ms"]
+    )
     assert set(row["profile"]) == set(BUDGET_PARTS)
     for part, functions in row["profile"].items():
         assert functions, part
