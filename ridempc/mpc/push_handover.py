@@ -11,7 +11,13 @@ foot swept 7 cm inwards under the edge and the deck went 0.47 -> 0.82 m/s in 60 
 rider fell). A re-push on a slowed board drifts from its reference (the entry is laid for a
 faster one) and crossed the handover's deviation in both its first strokes.
 
-So while a re-push has a foot off the deck (on the ground or swinging), the state's
+This is a slow board's: the stroke is timed for the stride's rolling start (its target less
+:data:`~ridempc.mpc.manoeuvre.REPUSH_BAND`), and a board slower than that carries the deck
+less far past the planted foot, which then lifts beside the deck's middle rather than near
+its tail. On a board at or above the rolling start the handover is as before (there, in the
+alternating yaw-rate steps, the deferred handover came later and every fall earlier). So
+while a re-push on a board slower than its stride's rolling start has a foot off the deck
+(on the ground or swinging), the state's
 *deviation* from the reference does not hand over; the MPC rides the stroke out and the
 deviation is judged again once every foot is back on the deck. A failed plan or an
 infeasible whole-body QP still hands over at once: the MPC then has nothing to ride with.
@@ -26,10 +32,13 @@ from ridempc.trajopt.schedule import Contact
 __all__ = ["deviation_deferred"]
 
 
-def deviation_deferred(repushing: bool, support: Iterable[Contact] | None) -> bool:
+def deviation_deferred(
+    repushing: bool, support: Iterable[Contact] | None, speed: float, rolling_start: float
+) -> bool:
     """Whether a deviation beyond the handover's bound waits (see the module docstring):
-    during a re-push (``repushing``) while any foot's ``support`` (per foot, this MPC
-    step's) is not the board."""
-    if not repushing or support is None:
+    during a re-push (``repushing``) on a board slower (``speed`` [m/s]) than the stride's
+    ``rolling_start`` [m/s] while any foot's ``support`` (per foot, this MPC step's) is not
+    the board."""
+    if not repushing or support is None or speed >= rolling_start:
         return False
     return any(contact is not Contact.BOARD for contact in support)

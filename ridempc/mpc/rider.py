@@ -126,6 +126,7 @@ from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HOLD,
     REPUSH,
+    REPUSH_BAND,
     Manoeuvre,
     ManoeuvreSelector,
     StateLayout,
@@ -676,7 +677,8 @@ class MpcRider(Controller):
         slack = self._diagnostics.get("wbc_slack", 0.0)
         if slack > 0.0:
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
-        stroke = deviation_deferred(self.manoeuvre.kind == REPUSH, self._support)
+        repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
+        stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
         if self._deviation > HANDOVER_DEVIATION and not stroke:  # a re-push's stroke rides out
             return out, f"state {self._deviation:.2g} of its tolerances from the reference"
         if not self._probation.proven and self._divergence.value > HANDOVER_DEVIATION:
