@@ -126,6 +126,7 @@ from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HOLD,
     REPUSH,
+    REPUSH_BAND,
     Manoeuvre,
     ManoeuvreSelector,
     StateLayout,
@@ -136,6 +137,7 @@ from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_gain import shifted_speeds
+from ridempc.mpc.push_handover import deviation_deferred
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.riding_posture import ride_qpos
@@ -675,7 +677,9 @@ class MpcRider(Controller):
         slack = self._diagnostics.get("wbc_slack", 0.0)
         if slack > 0.0:
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
-        if self._deviation > HANDOVER_DEVIATION:
+        repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
+        stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
+        if self._deviation > HANDOVER_DEVIATION and not stroke:  # a re-push's stroke rides out
             return out, f"state {self._deviation:.2g} of its tolerances from the reference"
         if not self._probation.proven and self._divergence.value > HANDOVER_DEVIATION:
             return out, (
