@@ -137,6 +137,7 @@ from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_gain import shifted_speeds
 from ridempc.mpc.push_side import PushSide, first_stride
+from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.riding_posture import ride_qpos
 from ridempc.mpc.roll_observer import RollObserver
@@ -536,6 +537,10 @@ class MpcRider(Controller):
             standby_every=1,
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
+        # the ride starts on the backup until the MPC is ready (mpc/readiness.py)
+        self.readiness = start_readiness(stages.takeover, RETURN_DWELL_S)
+        if self.readiness is not None:
+            self.handover.start_on_backup()
         self._diagnostics: dict[str, float] = {}
 
     def _disturbance_observer(self) -> DisturbanceObserver | None:
@@ -689,6 +694,8 @@ class MpcRider(Controller):
         the state near its reference (:func:`~ridempc.mpc.handover.deviation`) and not
         heading away from it faster than planned (:mod:`~ridempc.mpc.divergence`)."""
         plan = self._plan
+        if self.handover.starting:  # the start's backup: until the MPC is ready
+            return self.readiness is not None and self.readiness.ready
         settled = max(self._deviation, self._divergence.value) <= RETURN_DEVIATION
         return plan is not None and not plan.fallback and settled
 
@@ -737,6 +744,8 @@ class MpcRider(Controller):
             self._anchor(estimate, now, self._turned)
         else:
             switched = False
+            if self.handover.starting and self.manoeuvre.kind == HOLD:  # the frame on the
+                self._anchor(estimate, now, self._turned)  # board while the backup holds it
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
         mapped = self._mapped(estimate)
@@ -944,6 +953,10 @@ class MpcRider(Controller):
             self._probation.update(solve.time, settled, RETURN_DWELL_S)
         else:
             self._probation.restart()
+        if self.readiness is not None and self.handover.starting:
+            in_band = not plan.fallback and built.deviation <= RETURN_DEVIATION
+            settling = self.payload.estimate.settling() if self.payload is not None else None
+            self.readiness.update(solve.time, settling, in_band, self.manoeuvre.kind != HOLD)
         warming = not self._probation.proven and solve.time < STANDBY_WARMUP_S
         self.handover.standby_every = 1 if warming else self._standby_every
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
@@ -1301,6 +1314,9 @@ class MpcRider(Controller):
         out["wbc_elastic_solves"] = self.wbc.qp.elastic_solves
         out["wbc_slack_max"] = self._wbc_slack_max
         out["fallbacks"] = self.handover.summary()
+        out["mpc_takeover_s"] = 0.0 if self.readiness is None else self.handover.takeover_s
+        if self.readiness is not None:
+            out["takeover"] = self.readiness.summary()
         out["deviation_divergent_max"] = self._divergence.peak
         out["safe_hold"] = (
             None
