@@ -12,10 +12,14 @@ the MPC takes the ride when
 - its model's estimates have *settled*: over the last :attr:`StartRule.window` [s] each
   estimate :math:`e_j` moved by no more than its tolerance,
   :math:`\\max_w e_j - \\min_w e_j \\le \\epsilon_j`, with a full window of readings; and
-- the rider is within the MPC's return band of its reference (its deviation and the
-  deviation's divergent lead, :mod:`ridempc.mpc.divergence`, within
-  :data:`~ridempc.mpc.handover.RETURN_DEVIATION`) for :attr:`StartRule.dwell` [s], as a
-  return from any handover asks;
+- the rider is within the MPC's return band of its reference (its deviation within
+  :data:`~ridempc.mpc.handover.RETURN_DEVIATION`, the MPC's plan solved) for
+  :attr:`StartRule.dwell` [s], as a return from any handover asks; the reference's frame
+  is laid on the board while the backup holds it (the backup balances, it does not hold a
+  place or a heading: the MPC takes over where the rider is). The deviation's divergent
+  lead (:mod:`ridempc.mpc.divergence`) is left out here: it is the growth beyond what the
+  MPC's plan expected, and the backup does not follow that plan (under the PD it swung
+  between 0.6 and 2.7 and kept a settled rider out of the band);
 
 or, regardless of both,
 
@@ -24,6 +28,11 @@ or, regardless of both,
 - the rule has waited :attr:`StartRule.longest_wait` [s]: estimates that never settle
   (a noisy load signal) do not keep the ride on the backup for good. The MPC still takes
   it only where it has a command and no failure (the handover's own check).
+
+The estimates watched are the ones that learn while the backup rides: the payload's,
+read from the stance's loads. The disturbance observer (:mod:`ridempc.mpc.disturbance`)
+learns from the MPC's own plan's prediction error, which the backup does not follow: it
+is held until the MPC rides, and its probation (:mod:`ridempc.mpc.divergence`) covers it.
 
 Each outcome is recorded with its reason (:meth:`StartReadiness.summary`).
 """

@@ -80,8 +80,11 @@ the ride is handed to
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
-each handover is in ``summary()``'s ``fallbacks``. Only where the backup too has no
-finite command are the joints held where they are (``safe_hold``).
+each handover is in ``summary()``'s ``fallbacks``. With the pair's ``takeover`` stage the
+ride starts on that backup, the MPC planning beside it in a frame laid on the board and
+its payload estimate learning, and the MPC takes over once ready
+(:mod:`~ridempc.mpc.readiness`; when: ``summary()``'s ``mpc_takeover_s``). Only where the
+backup too has no finite command are the joints held where they are (``safe_hold``).
 """
 
 from __future__ import annotations
@@ -638,7 +641,10 @@ class MpcRider(Controller):
             self.estimator.update(sensors)
         primary, failure = self._primary(sensors, command)
         self._tick += 1
+        starting = self.handover.starting
         out = self.handover.step(sensors, command, primary, failure, self._fit())
+        if starting and not self.handover.starting:  # its rate measured the backup's ride
+            self._divergence.reset()  # away from plans it did not follow
         self._diagnostics["on_backup"] = float(self.handover.on_backup)
         if not out.is_finite():
             return self._safe_hold(sensors, f"no finite command from the backup law: {failure}")
