@@ -75,6 +75,17 @@ def test_never_stuck_the_longest_wait_with_its_reason() -> None:
         RULE.longest_wait, abs=STEP
     )
     assert nan.reason == LONGEST_WAIT
+    # out of the band then: the band is not waived, the dwell in it counts from its entry
+    late = StartReadiness(RULE)
+    assert _ride(late, moving, lambda t: t >= 2.2) == pytest.approx(2.2 + RULE.dwell, abs=STEP)
+    assert late.reason == LONGEST_WAIT
+    never = StartReadiness(RULE)
+    assert _ride(never, moving, lambda t: False) is None
+    assert never.summary() == {
+        "ready_s": None,
+        "reason": None,
+        "waiting_for": "the estimates to settle",
+    }
 
 
 def test_a_commanded_manoeuvre_takes_over_at_once() -> None:
