@@ -23,8 +23,10 @@ the MPC takes the ride when
 
 or, regardless of both,
 
-- a manoeuvre is commanded that only the MPC rides (anything but balancing in place:
-  the backup holds the rider, it does not follow the library), at once;
+- a manoeuvre is commanded that only the MPC rides (anything but balancing in place or
+  the stop that rides out a push: the backup holds the rider, it does not follow the
+  library), at once (taken over at a push's stop, the MPC was handed back 0.03 s later:
+  hard seed 31, v0018);
 
 or, regardless of the estimates,
 

@@ -962,7 +962,9 @@ class MpcRider(Controller):
         if self.readiness is not None and self.handover.starting:
             in_band = not plan.fallback and built.deviation <= RETURN_DEVIATION
             settling = self.payload.estimate.settling() if self.payload is not None else None
-            self.readiness.update(solve.time, settling, in_band, self.manoeuvre.kind != HOLD)
+            # a stop is the selector's ride-out of a push, which the backup rides too
+            commanded = self.manoeuvre.kind not in (HOLD, "stop")
+            self.readiness.update(solve.time, settling, in_band, commanded)
         warming = not self._probation.proven and solve.time < STANDBY_WARMUP_S
         self.handover.standby_every = 1 if warming else self._standby_every
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
