@@ -196,6 +196,17 @@ class DisturbanceStage(_Frozen):
     )
 
 
+class TakeoverStage(_Frozen):
+    window: Positive = Field(le=10.0, description="Estimates' change measured over this [s].")
+    mass_change: Positive = Field(
+        le=1.0, description="Largest change of the payload's mass over the window [-]."
+    )
+    shift_change: Positive = Field(
+        le=0.5, description="Largest change of the centre of mass's offset over it [m]."
+    )
+    longest_wait: Positive = Field(le=60.0, description="The MPC takes over by then [s].")
+
+
 class Stages(_Frozen):
     """The MPC rider's per-pair stages; a stage left out is not used."""
 
@@ -214,6 +225,7 @@ class Stages(_Frozen):
     settle: SettleStage | None = None
     payload: Used | None = None
     disturbance: DisturbanceStage | None = None
+    takeover: TakeoverStage | None = None
 
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
@@ -237,6 +249,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "settle": (frozenset(), ()),
     "payload": (frozenset(), ()),
     "disturbance": (frozenset(), ()),
+    "takeover": (frozenset(), ()),
 }
 
 

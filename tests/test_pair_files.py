@@ -150,6 +150,18 @@ def _edited(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ),
         ("cassie-segway", 'pyramid = "box"', 'pyramid = "cone"', "pyramid 'cone': allowed: box"),
         (
+            "cassie-hovershoes",
+            "longest_wait = 2.0",
+            "",
+            "field 'stages.takeover.longest_wait': Field required",
+        ),
+        (
+            "cassie-hovershoes",
+            "window = 0.3",
+            "window = -0.3",
+            "field 'stages.takeover.window': Input should be greater than 0",
+        ),
+        (
             "cassie-segway",
             '"left_hip_pitch", "right_hip_pitch"',
             '"left_hip", "right_hip_pitch"',

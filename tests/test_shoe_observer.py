@@ -120,8 +120,10 @@ def test_cassie_rides_shoes_staggered_under_her_feet(monkeypatch: pytest.MonkeyP
     MPC held the shoes' axes under the feet and the right shoe ran off (fell at 0.21 s).
     The observer finds the feet on their shoes within 5 mm of the truth and she rides.
     The MPC alone: the handover's early trigger hands this start to the PD
-    (docs/tuning.md, h-ride), whose ride the observer does not fit."""
+    (docs/tuning.md, h-ride), whose ride the observer does not fit, and the start is not
+    held on the PD (the pair's ``takeover`` stage, mpc/readiness.py)."""
     monkeypatch.setattr("ridempc.mpc.rider.HANDOVER_DEVIATION", math.inf)
+    monkeypatch.setattr("ridempc.mpc.rider.start_readiness", lambda *args: None)
     cassie = load_robot("cassie")
     board = load_board("hovershoes")
     scenario = resolve_scenario("offset-start", "hovershoes").with_duration(1.5)

@@ -20,6 +20,11 @@ estimator, the same filter on the same sensors as the primary's where both see t
 platforms: there it reads the primary's estimate instead (:func:`share_estimator`), and
 runs in standby only every :data:`STANDBY_DIVIDER` ticks.
 
+A ride may also *start* on the backup (:meth:`Handover.start_on_backup`): the primary then
+takes the ride, blended in as on a return, the first tick it is *ready*
+(:mod:`ridempc.mpc.readiness` decides when); the start is not a fallback, and the time the
+backup held it is :attr:`Handover.takeover_s`.
+
 Nothing here names a robot, a board or a law: :class:`Handover` takes the backup as a
 :class:`~ridempc.controllers.base.Controller` and is told, each tick, the primary's
 command (or None), why it failed (or None) and whether it is fit to ride.
@@ -150,6 +155,13 @@ class Handover:
         self._from: MotorCommand | None = None  # the command blended out of since then
         self._fit_since: float | None = None
         self._last_primary: MotorCommand | None = None
+        self.starting = False  # the backup holds the ride's start (start_on_backup)
+        self.takeover_s: float | None = None  # [s] when the primary took the start's ride
+
+    def start_on_backup(self) -> None:
+        """The ride starts on the backup; the primary takes it when ``step`` is told it is
+        ready, at once (no dwell: its readiness has its own)."""
+        self.starting = True
 
     def dwell(self) -> float:
         """How long the primary must be fit before it rides again [s]: :attr:`dwell_s`,
@@ -160,7 +172,7 @@ class Handover:
     @property
     def on_backup(self) -> bool:
         """Whether the backup rides."""
-        return bool(self.fallbacks) and self.fallbacks[-1].duration_s is None
+        return self.starting or bool(self.fallbacks) and self.fallbacks[-1].duration_s is None
 
     def step(
         self,
@@ -178,10 +190,18 @@ class Handover:
             primary: The primary's command this tick, None where it has none.
             failure: Why the primary cannot ride this tick, None if it can.
             fit: Whether the primary is fit to ride again (plans and QPs solving, the state
-                near its reference); read only while the backup rides.
+                near its reference); read only while the backup rides. While it holds the
+                start: whether the primary is ready to take it.
         """
         now = sensors.time
         backup = self._backup(sensors, command, primary is None or failure is not None)
+        if self.starting:
+            if failure is None and primary is not None and fit:
+                self.starting, self.takeover_s = False, now
+                self._switch(now, self._blended(now, backup))
+                self._last_primary = primary
+                return self._blended(now, primary)
+            return self._blended(now, backup)
         if not self.on_backup:
             if failure is None and primary is not None:
                 self._last_primary = primary

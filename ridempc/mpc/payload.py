@@ -131,6 +131,12 @@ class PayloadEstimate:
         out[1] = pin.Inertia(base.mass, lever, base.inertia)
         return out
 
+    def settling(self) -> Array:
+        """What the takeover watches settle (:mod:`ridempc.mpc.readiness`): the mass
+        beyond the model's as a fraction of it [-], and the offset along and across the
+        base [m] (its height is not observed)."""
+        return np.array([self.mass / self.model_mass, self.shift[0], self.shift[1]])
+
     def drift(self, nx: int, vz: int) -> Array:
         """The payload's weight as a constant term of the MPC's rates (nx): on the vertical
         velocity's row ``vz``, :math:`-g \\Delta m / m_0` [m/s^2]."""

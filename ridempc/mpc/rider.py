@@ -80,8 +80,11 @@ the ride is handed to
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
-each handover is in ``summary()``'s ``fallbacks``. Only where the backup too has no
-finite command are the joints held where they are (``safe_hold``).
+each handover is in ``summary()``'s ``fallbacks``. With the pair's ``takeover`` stage the
+ride starts on that backup, the MPC planning beside it in a frame laid on the board and
+its payload estimate learning, and the MPC takes over once ready
+(:mod:`~ridempc.mpc.readiness`; when: ``summary()``'s ``mpc_takeover_s``). Only where the
+backup too has no finite command are the joints held where they are (``safe_hold``).
 """
 
 from __future__ import annotations
@@ -139,6 +142,7 @@ from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_gain import shifted_speeds
 from ridempc.mpc.push_handover import deviation_deferred
 from ridempc.mpc.push_side import PushSide, first_stride
+from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.riding_posture import ride_qpos
 from ridempc.mpc.roll_observer import RollObserver
@@ -538,6 +542,10 @@ class MpcRider(Controller):
             standby_every=1,
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
+        # the ride starts on the backup until the MPC is ready (mpc/readiness.py)
+        self.readiness = start_readiness(stages.takeover, RETURN_DWELL_S)
+        if self.readiness is not None:
+            self.handover.start_on_backup()
         self._diagnostics: dict[str, float] = {}
 
     def _disturbance_observer(self) -> DisturbanceObserver | None:
@@ -635,7 +643,10 @@ class MpcRider(Controller):
             self.estimator.update(sensors)
         primary, failure = self._primary(sensors, command)
         self._tick += 1
+        starting = self.handover.starting
         out = self.handover.step(sensors, command, primary, failure, self._fit())
+        if starting and not self.handover.starting:  # its rate measured the backup's ride
+            self._divergence.reset()  # away from plans it did not follow
         self._diagnostics["on_backup"] = float(self.handover.on_backup)
         if not out.is_finite():
             return self._safe_hold(sensors, f"no finite command from the backup law: {failure}")
@@ -693,6 +704,8 @@ class MpcRider(Controller):
         the state near its reference (:func:`~ridempc.mpc.handover.deviation`) and not
         heading away from it faster than planned (:mod:`~ridempc.mpc.divergence`)."""
         plan = self._plan
+        if self.handover.starting:  # the start's backup: until the MPC is ready
+            return self.readiness is not None and self.readiness.ready
         settled = max(self._deviation, self._divergence.value) <= RETURN_DEVIATION
         return plan is not None and not plan.fallback and settled
 
@@ -741,6 +754,8 @@ class MpcRider(Controller):
             self._anchor(estimate, now, self._turned)
         else:
             switched = False
+            if self.handover.starting and self.manoeuvre.kind == HOLD:  # the frame on the
+                self._anchor(estimate, now, self._turned)  # board while the backup holds it
         t_ref = self.manoeuvre.reference_time(now)
         names, roll = self.layout.names, self._roll_horizon(command, now)
         mapped = self._mapped(estimate)
@@ -948,6 +963,12 @@ class MpcRider(Controller):
             self._probation.update(solve.time, settled, RETURN_DWELL_S)
         else:
             self._probation.restart()
+        if self.readiness is not None and self.handover.starting:
+            in_band = not plan.fallback and built.deviation <= RETURN_DEVIATION
+            settling = self.payload.estimate.settling() if self.payload is not None else None
+            # a stop is the selector's ride-out of a push, which the backup rides too
+            commanded = self.manoeuvre.kind not in (HOLD, "stop")
+            self.readiness.update(solve.time, settling, in_band, commanded)
         warming = not self._probation.proven and solve.time < STANDBY_WARMUP_S
         self.handover.standby_every = 1 if warming else self._standby_every
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
@@ -1305,6 +1326,9 @@ class MpcRider(Controller):
         out["wbc_elastic_solves"] = self.wbc.qp.elastic_solves
         out["wbc_slack_max"] = self._wbc_slack_max
         out["fallbacks"] = self.handover.summary()
+        out["mpc_takeover_s"] = 0.0 if self.readiness is None else self.handover.takeover_s
+        if self.readiness is not None:
+            out["takeover"] = self.readiness.summary()
         out["deviation_divergent_max"] = self._divergence.peak
         out["safe_hold"] = (
             None

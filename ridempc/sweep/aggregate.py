@@ -12,8 +12,9 @@ from ridempc.sweep.stats import mcnemar_p, metric_spread, paired_counts, survive
 
 __all__ = ["SWEEP_METRICS", "VariantRecord", "sweep_results"]
 
-# Metrics summarised per controller: compare's table, and when the rider fell [s].
-SWEEP_METRICS: dict[str, str] = {**COMPARED_METRICS, "fall_time_s": "s"}
+# Metrics summarised per controller: compare's table, when the rider fell [s], and how long
+# the backup held the start before the MPC took over [s] (ridempc.mpc.readiness).
+SWEEP_METRICS: dict[str, str] = {**COMPARED_METRICS, "fall_time_s": "s", "mpc_takeover_s": "s"}
 
 VariantRecord = Mapping[str, Any]  # id, seed, drawn, scenario_file
 
