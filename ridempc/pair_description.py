@@ -214,6 +214,7 @@ class Stages(_Frozen):
     settle: SettleStage | None = None
     payload: Used | None = None
     disturbance: DisturbanceStage | None = None
+    drop: Used | None = None
 
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
@@ -237,6 +238,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "settle": (frozenset(), ()),
     "payload": (frozenset(), ()),
     "disturbance": (frozenset(), ()),
+    "drop": (frozenset(), ()),
 }
 
 

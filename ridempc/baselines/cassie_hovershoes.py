@@ -134,6 +134,7 @@ class CassieHovershoes(CassieStanding):
         self._loaded_pitch = np.zeros(2)  # each foot's pitch, last loaded [rad]
         self._time = 0.0
         self._extension = np.zeros(2)  # each leg's length added to reach its falling shoe [m]
+        self._unloaded_for = np.zeros(2)  # how long each foot has been unloaded [s]
 
     # ------------------------------------------------------------------ state
 
@@ -147,6 +148,7 @@ class CassieHovershoes(CassieStanding):
         self._unloaded[:] = False
         self._loaded_com_x[:] = 0.0
         self._extension[:] = 0.0
+        self._unloaded_for[:] = 0.0
         self._loaded_pitch = self._foot_pitches(self.kinematic_state(sensors))
         for low_pass in (
             self._speed_filter,
@@ -310,7 +312,10 @@ class CassieHovershoes(CassieStanding):
         self._time = state.time
         if gains.unloaded_shin == 0.0:
             return state
-        reach = np.where(self._unloaded, gains.extend_speed, -self.gains.legs.max_speed)
+        self._unloaded_for = np.where(self._unloaded, self._unloaded_for + dt, 0.0)
+        falling = self._unloaded_for >= gains.reach_delay
+        reach = np.where(falling, gains.extend_speed, -self.gains.legs.max_speed)
+        reach[self._unloaded & ~falling] = 0.0
         self._extension = np.clip(self._extension + reach * dt, 0.0, gains.max_extension)
         if not self._unloaded.any():
             self._loaded_com_x = np.array([state.com_offset[0], state.com_velocity[0]])

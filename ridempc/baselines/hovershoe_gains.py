@@ -126,6 +126,9 @@ class FlightGains(_Frozen):
         0.0, description="Speed at which an unloaded leg reaches down [m/s]; 0 = never."
     )
     max_extension: NonNegative = Field(0.0, description="Longest reach down [m].")
+    reach_delay: NonNegative = Field(
+        0.0, description="How long a foot is unloaded before its leg reaches down [s]."
+    )
 
 
 class CassieHovershoesGains(_Frozen):
