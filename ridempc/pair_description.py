@@ -227,6 +227,8 @@ class Stages(_Frozen):
     disturbance: DisturbanceStage | None = None
     takeover: TakeoverStage | None = None
 
+    drop: Used | None = None
+
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
         return tuple(name for name in type(self).model_fields if getattr(self, name) is not None)
@@ -250,6 +252,8 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "payload": (frozenset(), ()),
     "disturbance": (frozenset(), ()),
     "takeover": (frozenset(), ()),
+
+    "drop": (frozenset(), ()),
 }
 
 

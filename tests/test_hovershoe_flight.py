@@ -74,3 +74,55 @@ def test_unloaded_foot_has_its_ankle_held_without_torque() -> None:
         assert unloaded.torque[toe] == 0.0
         assert unloaded.kp[toe] == flight.kp_toe
     assert controller.diagnostics()["left_unloaded"] == 1.0
+
+
+def test_unloaded_leg_reaches_down_and_comes_back_at_the_posture_rate() -> None:
+    """A foot whose shoe falls away: after ``reach_delay`` its leg lengthens at
+    ``extend_speed`` up to ``max_extension``; loaded again, it shortens at the posture's
+    slew rate."""
+    robot = load_robot("cassie")
+    controller = make_controller("pd", robot, "hovershoes")
+    assert isinstance(controller, CassieHovershoes)
+    flight, legs = controller.rider_gains.flight, controller.gains.legs
+    assert flight.extend_speed > 0.0 and flight.max_extension > 0.0
+    dt = 0.002
+
+    def length(time: float, shin: float) -> float:
+        controller.update(_packet(robot, time, shin=shin), Command())
+        return controller.diagnostics()["left_leg_length_target"]
+
+    controller.update(_packet(robot, 0.0, shin=-0.04), Command())
+    standing = length(dt, -0.04)
+    reach = flight.reach_delay + 0.02  # [s] of flight, short of the longest reach
+    for k in range(round(reach / dt)):
+        reached = length(2 * dt + (k + 1) * dt, 0.0)
+    assert reached - standing == pytest.approx(
+        0.02 * flight.extend_speed, abs=3 * dt * flight.extend_speed
+    )
+    back = 0.05  # [s] loaded again
+    t = 2 * dt + reach
+    for k in range(round(back / dt)):
+        returned = length(t + (k + 1) * dt, -0.04)
+    assert reached - returned == pytest.approx(legs.max_speed * back, rel=0.15)
+    for k in range(round(1.0 / dt)):  # a long flight: the reach stops at its longest
+        longest = length(t + back + (k + 1) * dt, 0.0)
+    assert longest - standing == pytest.approx(flight.max_extension, abs=0.01)
+
+
+def test_a_stamping_foot_does_not_ratchet_its_leg_longer() -> None:
+    """Unloaded for less than ``reach_delay`` at a time, then loaded: the leg keeps its
+    length (a reach at each short unload, undone at the slow slew rate, would ratchet)."""
+    robot = load_robot("cassie")
+    controller = make_controller("pd", robot, "hovershoes")
+    assert isinstance(controller, CassieHovershoes)
+    dt, half = 0.002, 0.5 * controller.rider_gains.flight.reach_delay
+    controller.update(_packet(robot, 0.0, shin=-0.04), Command())
+    controller.update(_packet(robot, dt, shin=-0.04), Command())
+    standing = controller.diagnostics()["left_leg_length_target"]
+    t = dt
+    for _ in range(10):  # 10 stamps, each unloaded for half the delay
+        for shin in (0.0, -0.04):
+            for _ in range(round(half / dt)):
+                t += dt
+                controller.update(_packet(robot, t, shin=shin), Command())
+    assert controller.diagnostics()["left_leg_length_target"] == pytest.approx(standing, abs=1e-3)

@@ -50,9 +50,9 @@ pitches (:math:`\\theta` the virtual leg angles). Without it a turn only stagger
 
 A shoe in the air (a step's drop; :mod:`ridempc.baselines.hovershoe_flight`, ``[flight]``):
 while a leg's shin spring says its foot is unloaded, that toe gets no torque fed forward
-and keeps the foot at its last loaded pitch in the world, and the CoP law reads the CoM x
-over the feet held at its last loaded value. On flat ground no shin relaxes and the law
-above is the paper's.
+and keeps the foot at its last loaded pitch in the world, the leg lengthens to follow its
+shoe down, and the CoP law reads the CoM x over the feet held at its last loaded value.
+On flat ground no shin relaxes and the law above is the paper's.
 
 The controller runs the state estimator every tick with one platform per foot (left foot
 on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Gains:
@@ -132,6 +132,9 @@ class CassieHovershoes(CassieStanding):
         self._unloaded = np.zeros(2, dtype=bool)
         self._loaded_com_x = np.zeros(2)  # CoM x over the feet and its rate, last loaded
         self._loaded_pitch = np.zeros(2)  # each foot's pitch, last loaded [rad]
+        self._time = 0.0
+        self._extension = np.zeros(2)  # each leg's length added to reach its falling shoe [m]
+        self._unloaded_for = np.zeros(2)  # how long each foot has been unloaded [s]
 
     # ------------------------------------------------------------------ state
 
@@ -144,6 +147,8 @@ class CassieHovershoes(CassieStanding):
         self._integral_time = None
         self._unloaded[:] = False
         self._loaded_com_x[:] = 0.0
+        self._extension[:] = 0.0
+        self._unloaded_for[:] = 0.0
         self._loaded_pitch = self._foot_pitches(self.kinematic_state(sensors))
         for low_pass in (
             self._speed_filter,
@@ -303,8 +308,15 @@ class CassieHovershoes(CassieStanding):
         gains = self.rider_gains.flight
         shins = np.array([state.q[self.kinematics.legs[s].q[LegIndices.SHIN]] for s in SIDES])
         self._unloaded = unloaded_feet(shins, gains.unloaded_shin)
+        dt = max(state.time - self._time, 0.0)
+        self._time = state.time
         if gains.unloaded_shin == 0.0:
             return state
+        self._unloaded_for = np.where(self._unloaded, self._unloaded_for + dt, 0.0)
+        falling = self._unloaded_for >= gains.reach_delay
+        reach = np.where(falling, gains.extend_speed, -self.gains.legs.max_speed)
+        reach[self._unloaded & ~falling] = 0.0
+        self._extension = np.clip(self._extension + reach * dt, 0.0, gains.max_extension)
         if not self._unloaded.any():
             self._loaded_com_x = np.array([state.com_offset[0], state.com_velocity[0]])
             self._loaded_pitch = self._foot_pitches(state)
@@ -314,6 +326,11 @@ class CassieHovershoes(CassieStanding):
         com_velocity = state.com_velocity.copy()
         com_velocity[0] = self._loaded_com_x[1]
         return dataclasses.replace(state, com=com, com_velocity=com_velocity)
+
+    def leg_extension(self, side: str) -> float:
+        """An unloaded leg reaches down after its falling shoe; loaded again, it shortens back
+        at the posture's slew rate, so the rider comes down the step over the legs' stroke."""
+        return float(self._extension[SIDES.index(side)])
 
     def hold_ankles(self, state: KinematicState, command: MotorCommand) -> MotorCommand:
         """An unloaded foot's toe turned to keep the foot at its last loaded pitch in the

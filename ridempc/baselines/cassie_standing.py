@@ -279,6 +279,10 @@ class CassieStanding(Controller):
             for i, side in enumerate(SIDES)
         }
 
+    def leg_extension(self, side: str) -> float:
+        """A leg's length added to the posture's [m]; none here."""
+        return 0.0
+
     def motor_command(self, state: KinematicState, targets: StandingTargets) -> MotorCommand:
         """Steps 1-6: joint targets, their velocities and the feedforward torques."""
         position = state.motor_position.copy()  # the toe's target: where it is
@@ -290,7 +294,8 @@ class CassieStanding(Controller):
         lean = -np.arctan2(targets.com_y, mean_length)
         for side in SIDES:
             m, table, sign = self.kinematics.legs[side].motors, self.legs[side], SIGN[side]
-            length = min(max(mean_length - sign * u, limits.min_length), limits.max_length)
+            length = mean_length - sign * u + self.leg_extension(side)
+            length = min(max(length, limits.min_length), limits.max_length)
             measured = table.forward(
                 state.motor_position[m[LegIndices.HIP_PITCH]],
                 state.motor_position[m[LegIndices.KNEE]],

@@ -14,7 +14,13 @@ While a foot is unloaded, :class:`~ridempc.baselines.cassie_hovershoes.CassieHov
   world it had when last loaded (from the IMU and the leg's kinematics), so the shoe keeps
   its pitch through the flight and lands as it left, and
 - holds the CoM's position and velocity over the feet that the centre-of-pressure law
-  reads at their last loaded values (the falling feet are not the rider tipping back).
+  reads at their last loaded values (the falling feet are not the rider tipping back), and
+- lengthens its leg at ``extend_speed`` (up to ``max_extension``) so that the foot follows
+  its falling shoe down; loaded again, the leg shortens back at the posture's slew rate.
+  A leg held at its length instead lets the rider fall the whole step onto the shoes
+  (1.1 m/s down a 7.6 cm step): the legs then take the landing 13 cm deep at two to three
+  times the rider's weight, whose lever about each axle pitches the shoe nose up and its
+  firmware brakes it to a stop under a rider still rolling on.
 """
 
 from __future__ import annotations

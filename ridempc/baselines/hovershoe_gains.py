@@ -122,6 +122,13 @@ class FlightGains(_Frozen):
     kp_toe: NonNegative = Field(
         0.0, description="Stiffness holding an unloaded foot at its last pitch [N m/rad]."
     )
+    extend_speed: NonNegative = Field(
+        0.0, description="Speed at which an unloaded leg reaches down [m/s]; 0 = never."
+    )
+    max_extension: NonNegative = Field(0.0, description="Longest reach down [m].")
+    reach_delay: NonNegative = Field(
+        0.0, description="How long a foot is unloaded before its leg reaches down [s]."
+    )
 
 
 class CassieHovershoesGains(_Frozen):

@@ -112,6 +112,7 @@ from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.delay import predicted_start
 from ridempc.mpc.disturbance import DisturbanceObserver, disturbance_rows
 from ridempc.mpc.divergence import DivergentDeviation, Probation
+from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
@@ -530,6 +531,8 @@ class MpcRider(Controller):
         self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
         self._divergence = DivergentDeviation()  # where that deviation is heading
         self._probation = Probation()  # whether the MPC has shown its model holds the rider
+        # the platforms falling away under the feet (a step), with the ``drop`` stage
+        self._drop = DropDetector() if self.pair.description.stages.drop is not None else None
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
@@ -608,6 +611,8 @@ class MpcRider(Controller):
         self.estimator.reset(sensors)
         self.map.reset()
         self.torque_lead.reset()
+        if self._drop is not None:
+            self._drop.reset()
         self._tick = 0
         self._plan = None
         estimate = self.estimator.state
@@ -665,6 +670,7 @@ class MpcRider(Controller):
             np.isfinite(estimate.q).all() and np.isfinite(estimate.v).all()
         ):
             return None, "state estimate not finite"
+        dropping = self._drop is not None and self._drop.update(self.estimator.contact.last_load)
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
         if self.payload is not None:
@@ -685,6 +691,8 @@ class MpcRider(Controller):
             return None, f"{type(exc).__name__}: {exc}"
         if self._plan.fallback:
             return out, f"MPC plan failed (status {self._plan.status})"
+        if dropping:
+            return out, "every foot's load gone at once (a drop)"
         slack = self._diagnostics.get("wbc_slack", 0.0)
         if slack > 0.0:
             return out, f"whole-body QP infeasible (slack {slack:.3g})"

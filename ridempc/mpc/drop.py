@@ -1,0 +1,68 @@
+"""A drop under the rider: every foot's load gone at once, read from its contact detector.
+
+Rolling off a step, the rider's platforms fall away from under her feet before she follows
+them: the feet's loads (:class:`~ridempc.estimation.contact.ContactDetector`, the part of
+her weight each foot carries as a fraction of its standing share) fall together. The MPC's
+model has no flight phase, so its plans keep pressing the feet against platforms that are
+not there (on the Hovershoes: the shoes pushed down at up to 3 g, pitched nose down, and
+landing on wheels that their firmware spun up in the air), and the ride is handed to the
+backup law (:mod:`ridempc.mpc.handover`), which has a flight phase of its own. A foot
+lifted on purpose (a skateboard's pushing foot) leaves the others loaded, so it is no drop.
+
+.. math:: \\text{drop} \\iff \\max_i \\ell_i < \\ell_{drop} \\text{ for } n_{drop}
+          \\text{ ticks in a row}
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["ARM_TICKS", "DROP_LOAD", "DROP_TICKS", "DropDetector"]
+
+# [-] every foot's load below this share of its standing load: riding, the loads sit at
+# 0.9-1.1 and one foot's swings to 0.7; rolling off a step of 171 % of a Hovershoe's wheel
+# radius under the MPC both fall from 1.0 to 0.6 within 0.06 s, before the shoes land.
+DROP_LOAD: float = 0.6
+# [ticks] in a row, 4 ms at 500 Hz: one tick's low reading (a bump) is no drop.
+DROP_TICKS: int = 2
+# [ticks] every foot loaded in a row, 0.1 s at 500 Hz, before a drop can be told: the rider
+# standing on her platforms (the detector's loads start from a placeholder, and a ride may
+# start with the rider settling onto them).
+ARM_TICKS: int = 50
+
+
+class DropDetector:
+    """Whether every foot has lost its load at once (a drop), from the feet's loads.
+
+    Args:
+        threshold: Load fraction below which a foot is unloaded [-] (``DROP_LOAD``).
+        ticks: Ticks in a row for a drop (``DROP_TICKS``).
+    """
+
+    def __init__(self, threshold: float = DROP_LOAD, ticks: int = DROP_TICKS) -> None:
+        if not 0.0 < threshold < 1.0 or ticks < 1:
+            raise ValueError(f"drop: threshold {threshold} (0-1), ticks {ticks} (>= 1)")
+        self.threshold = threshold
+        self.ticks = ticks
+        self._count = 0
+        self._loaded = 0
+        self._armed = False
+
+    def reset(self) -> None:
+        self._count = 0
+        self._loaded = 0
+        self._armed = False
+
+    def update(self, loads: NDArray[np.float64]) -> bool:
+        """Take this tick's loads (one per foot, fractions of the standing share [-]);
+        True while every one has been below the threshold for ``ticks`` ticks, once they
+        have all been above it for ``ARM_TICKS`` (a rider not yet standing drops nothing)."""
+        if not np.size(loads):
+            return False
+        loaded = float(np.min(loads)) >= self.threshold
+        self._loaded = self._loaded + 1 if loaded else 0
+        self._armed = self._armed or self._loaded >= ARM_TICKS
+        low = self._armed and float(np.max(loads)) < self.threshold
+        self._count = self._count + 1 if low else 0
+        return self._count >= self.ticks

@@ -1,0 +1,65 @@
+"""A drop under the rider: every foot's load gone at once (ridempc/mpc/drop.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ridempc.mpc.drop import ARM_TICKS, DROP_LOAD, DROP_TICKS, DropDetector
+from ridempc.pair_description import load_pair_description
+
+
+def _stood(detector: DropDetector) -> None:
+    for _ in range(ARM_TICKS):
+        assert not detector.update(np.array([1.0, 1.0]))
+
+
+def test_every_foot_unloaded_for_the_ticks_is_a_drop() -> None:
+    detector = DropDetector()
+    _stood(detector)
+    low = np.array([0.5 * DROP_LOAD, 0.9 * DROP_LOAD])
+    told = [detector.update(low) for _ in range(DROP_TICKS + 2)]
+    assert told == [False] * (DROP_TICKS - 1) + [True] * 3
+
+
+def test_one_foot_lifted_is_no_drop() -> None:
+    """A foot lifted on purpose (a skateboard's push) leaves another loaded."""
+    detector = DropDetector()
+    _stood(detector)
+    assert not any(detector.update(np.array([0.0, 1.0])) for _ in range(100))
+
+
+def test_a_single_low_tick_is_no_drop_and_loads_back_end_it() -> None:
+    detector = DropDetector()
+    _stood(detector)
+    low, loaded = np.zeros(2), np.ones(2)
+    assert not detector.update(low)
+    assert not detector.update(loaded)
+    assert not detector.update(low)
+    for _ in range(DROP_TICKS):
+        detector.update(low)
+    assert detector.update(low)
+    assert not detector.update(loaded)
+
+
+def test_a_rider_not_yet_standing_drops_nothing() -> None:
+    """The ride's first ticks, before every foot has carried its share, are no drop."""
+    detector = DropDetector()
+    assert not detector.update(np.ones(2))  # the detector's placeholder loads
+    assert not any(detector.update(np.zeros(2)) for _ in range(100))
+    detector.reset()
+    _stood(detector)
+    assert [detector.update(np.zeros(2)) for _ in range(DROP_TICKS)][-1]
+
+
+def test_bad_settings_are_refused() -> None:
+    with pytest.raises(ValueError, match="threshold"):
+        DropDetector(threshold=1.5)
+    with pytest.raises(ValueError, match="ticks"):
+        DropDetector(ticks=0)
+
+
+def test_the_hovershoes_pair_uses_the_drop_and_the_others_do_not() -> None:
+    assert load_pair_description("cassie", "hovershoes").stages.drop is not None
+    for robot, board in (("cassie", "segway"), ("cyberdog2", "skateboard")):
+        assert load_pair_description(robot, board).stages.drop is None
