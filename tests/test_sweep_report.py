@@ -32,7 +32,9 @@ def _results(
             }  # fmt: skip
             if c == "mpc" and i in handed:  # handed to the PD once, or twice for i = 3
                 fallback = {"time_s": 1.0, "reason": "WbcFailed: ...", "duration_s": 0.6}
-                summaries[(v["id"], c)]["fallbacks"] = [fallback] * (2 if i == 3 else 1)
+                kept = {**fallback, "duration_s": None}  # i = 1: the PD rides to the end
+                last = kept if i == 1 else fallback
+                summaries[(v["id"], c)]["fallbacks"] = [fallback] * (1 if i == 3 else 0) + [last]
     return sweep_results(HEADER, variants, ["pd", "mpc"], summaries)
 
 
@@ -76,7 +78,8 @@ def test_fallbacks_are_counted_and_reported(tmp_path: Path) -> None:
     results = _results(set(), {8}, handed=frozenset({1, 3, 8}))
     mpc = results["controllers"]["mpc"]
     assert (mpc["fallback_rides"], mpc["fallbacks"]) == (3, 4)
+    assert mpc["backup_survivals"] == 1  # v0001 ended on the PD; v0003 handed back twice
     assert results["controllers"]["pd"]["fallbacks"] == 0
     write_report(results, tmp_path)
     assert "| mpc | 9/10 | 90.0% |" in (tmp_path / "report.md").read_text()
-    assert "3 rides (4)" in (tmp_path / "report.md").read_text()
+    assert "3 rides (4), 1 survived on it" in (tmp_path / "report.md").read_text()

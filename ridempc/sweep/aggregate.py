@@ -36,7 +36,9 @@ def sweep_results(
     Returns:
         ``controllers``: per controller ``rides``, ``survived``, ``failed``,
         ``fallback_rides`` and ``fallbacks`` (rides handed to a backup law, and handovers
-        in all: a summary's ``fallbacks``, :mod:`ridempc.mpc.handover`), ``survival_rate``,
+        in all: a summary's ``fallbacks``, :mod:`ridempc.mpc.handover`),
+        ``backup_survivals`` (rides that survived on the backup: their last handover never
+        handed back, so the ride's end was the backup's, not the controller's), ``survival_rate``,
         ``survival_ci95`` (Wilson, [low, high]), ``metrics`` (median, p90, min, max per
         metric) and ``worker_peak_rss_mib``; ``paired``: per pair of
         controllers the four paired counts and the exact McNemar p-value; ``failed``: the
@@ -58,6 +60,7 @@ def sweep_results(
             "failed": sum(1 for s in rides if s.get("status") == "failed"),
             "fallback_rides": sum(1 for n in handovers if n),
             "fallbacks": sum(handovers),
+            "backup_survivals": sum(1 for s in rides if survived(s) and _on_backup(s)),
             "survival_rate": kept / len(rides) if rides else None,
             "survival_ci95": [low, high],
             "metrics": {
@@ -81,3 +84,10 @@ def sweep_results(
             {**v, "summaries": {c: summaries[(v["id"], c)] for c in controllers}} for v in variants
         ],
     }
+
+
+def _on_backup(summary: Mapping[str, Any]) -> bool:
+    """The ride ended on the backup: its last handover has no ``duration_s`` (never handed
+    back, :class:`ridempc.mpc.handover.Fallback`)."""
+    fallbacks: Sequence[Mapping[str, Any]] = summary.get("fallbacks") or []
+    return bool(fallbacks) and fallbacks[-1].get("duration_s") is None

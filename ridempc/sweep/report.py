@@ -87,8 +87,11 @@ def survival_table(results: Mapping[str, Any]) -> str:
     for name, c in results["controllers"].items():
         low, high = c["survival_ci95"]
         memory = c["worker_peak_rss_mib"]
-        # rides handed to a backup law (ridempc.mpc.handover), and handovers in all
+        # rides handed to a backup law (ridempc.mpc.handover), handovers in all, and the
+        # survivals that ended on the backup (the backup's, not the controller's)
         handed = f"{c.get('fallback_rides', 0)} rides ({c.get('fallbacks', 0)})"
+        if c.get("backup_survivals"):
+            handed += f", {c['backup_survivals']} survived on it"
         rows.append(
             [
                 name,
