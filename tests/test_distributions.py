@@ -62,7 +62,7 @@ def test_hard_is_wider_than_everyday() -> None:
         hard = load_distribution("hard", board).quantities(2)
         push = "push.magnitude"
         assert hard[push].bounds()[1] > everyday[push].bounds()[1]
-        assert hard["payload.fraction"].bounds() == (0.0, 0.3)
+        assert hard["payload.fraction"].bounds() == (-0.3, 0.3)
         assert hard["noise.scale"].bounds()[1] == 2.0
         assert hard["changes.motor_torque_limit.scale"].bounds()[0] == 0.8
 
