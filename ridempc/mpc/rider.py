@@ -1249,6 +1249,7 @@ class MpcRider(Controller):
             swing_position=swing,
             swing_velocity=swing_velocity,
             posture=posture,
+            board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
         out = self.wbc.solve(estimate, targets)
         if self.shoes is not None:
