@@ -115,6 +115,20 @@ def test_moves_the_mpc_shoes_behind_their_feet_and_adds_the_drag(shoes) -> None:
     assert LIMIT >= 0.04  # a 4 cm offset is within what the fit may say
 
 
+def test_gives_the_whole_body_qp_each_shoes_drag_along_its_heading(shoes) -> None:
+    """The drag the MPC's speed equations have is the acceleration the whole-body QP's
+    rolling platforms give the feet on the bare shoe, along each shoe's own heading."""
+    observer = ShoeObserver(shoes, [0, 1])
+    observer.drag = np.array([54.0, -2.0])  # [N] down a 13 deg slope, and level ground
+    left = BoardEstimate(("a",), np.zeros(3), 0.5, -0.1, 0.0, np.zeros(3), 0.0)
+    right = BoardEstimate(("b",), np.zeros(3), -0.2, 0.0, 0.0, np.zeros(3), 0.0)
+    drift = observer.drift((left, right))
+    m = shoes.shoe_mass
+    np.testing.assert_allclose(drift[0], 54.0 / m * np.array([math.cos(0.5), math.sin(0.5), 0]))
+    np.testing.assert_allclose(drift[1], -2.0 / m * np.array([math.cos(0.2), -math.sin(0.2), 0]))
+    assert observer.drift((left,)) == ()  # not its shoes: nothing
+
+
 def test_cassie_rides_shoes_staggered_under_her_feet(monkeypatch: pytest.MonkeyPatch) -> None:
     """The offset start: shoes staggered by 6 cm, feet 1 cm forward. Told nothing of it, the
     MPC held the shoes' axes under the feet and the right shoe ran off (fell at 0.21 s).

@@ -54,7 +54,9 @@ Every 2 ms (500 Hz) the rider
    :mod:`ridempc.mpc.force_filter`), the feet in
    contact as the schedule has them over the step, and, for a foot the schedule lifts, a
    swing target where the reference puts it, carried by the estimated board
-   (:mod:`ridempc.mpc.swing`); and solves the 500 Hz whole-body QP
+   (:mod:`ridempc.mpc.swing`), and on the Hovershoes each shoe's fitted drag as its
+   rolling platform's acceleration (:meth:`~ridempc.mpc.shoe_observer.ShoeObserver.drift`);
+   and solves the 500 Hz whole-body QP
    (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the reference's
    joint angles where the library has them, the dog's, else the robot's riding posture
    on the board, its stance unless a riding keyframe is given: the stance would hold the
@@ -1282,6 +1284,7 @@ class MpcRider(Controller):
             swing_position=swing,
             swing_velocity=swing_velocity,
             posture=posture,
+            board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
         out = self.wbc.solve(estimate, targets)
         if self.shoes is not None:

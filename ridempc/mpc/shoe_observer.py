@@ -60,7 +60,10 @@ the shoes' 4 Hz pitch and feed it).
 wants it :math:`d` behind where the reference puts the foot
 (:meth:`ShoeObserver.shift_reference`: the library's shoes carry their feet over their axes,
 and held to them a rider on staggered shoes would scissor her feet to line the axes up), and
-has :math:`D` in its speed equations (:meth:`ShoeObserver.speed_drift`).
+has :math:`D` in its speed equations (:meth:`ShoeObserver.speed_drift`); the whole-body QP
+has it in its rolling platforms' acceleration (:meth:`ShoeObserver.drift`): down a slope the
+pull on a shoe is some 50 N, and a QP that leaves it out takes a nose-up shoe for one that
+brakes at :math:`c_4\theta / m_s` (20 m/s^2 at -0.13 rad) and moves the feet for it.
 """
 
 from __future__ import annotations
@@ -225,6 +228,18 @@ class ShoeObserver:
         out = np.array(c, dtype=float)
         out[:, list(speeds)] += self.drag * dt / self.shoe_mass
         return out
+
+    def drift(self, boards: Sequence[BoardEstimate]) -> tuple[Array, ...]:
+        """Each shoe's drag as the acceleration it gives the bare shoe along its heading,
+        :math:`D / m_s` [m/s^2] (world, one 3-vector per platform): what the whole-body QP's
+        rolling platforms (:mod:`~ridempc.wbc.platforms`, eq. (8) without :math:`D`) add to
+        the feet's acceleration on them."""
+        if len(boards) != self.platforms:
+            return ()
+        return tuple(
+            (d / self.shoe_mass) * np.array([math.cos(b.yaw), math.sin(b.yaw), 0.0])
+            for b, d in zip(boards, self.drag.tolist(), strict=True)
+        )
 
     def shift_reference(self, states: Array, columns: Sequence[Sequence[int]]) -> Array:
         """A copy of the MPC's reference ``states`` (nodes x nx) with each shoe moved
