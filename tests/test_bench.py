@@ -125,7 +125,7 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     from ridempc.bench import bench_table
 
     lines = bench_table([out]).splitlines()
-    assert any(line.endswith(f"| {out.reference_ms:.2f} |") for line in lines)
+    assert any(f"| {out.reference_ms:.2f} |" in line for line in lines)
     # the same QPs, to DAQP and proxqp: the same optimum (OSQP polished to its active set)
     assert {"osqp", "daqp"} <= set(out.wbc_solvers)
     for name, figures in out.wbc_solvers.items():
