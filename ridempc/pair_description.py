@@ -196,6 +196,10 @@ class DisturbanceStage(_Frozen):
     )
 
 
+class ImpulseStage(_Frozen):
+    band: Speed = Field(description="Largest unexplained velocity change the MPC rides [m/s].")
+
+
 class Stages(_Frozen):
     """The MPC rider's per-pair stages; a stage left out is not used."""
 
@@ -214,6 +218,7 @@ class Stages(_Frozen):
     settle: SettleStage | None = None
     payload: Used | None = None
     disturbance: DisturbanceStage | None = None
+    impulse: ImpulseStage | None = None
 
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
@@ -237,6 +242,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "settle": (frozenset(), ()),
     "payload": (frozenset(), ()),
     "disturbance": (frozenset(), ()),
+    "impulse": (frozenset(), ()),
 }
 
 

@@ -121,6 +121,7 @@ from ridempc.mpc.handover import (
     deviation,
     share_estimator,
 )
+from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger, com_velocity
 from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -537,6 +538,13 @@ class MpcRider(Controller):
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
         self._diagnostics: dict[str, float] = {}
+        # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
+        band = stages.impulse.band if stages.impulse is not None else None
+        mass = self.wbc.model.mass  # [kg] the rider's, as modelled
+        self.impulse = ImpulseObserver(mass) if band is not None else None
+        self._push_trigger = ImpulseTrigger(band) if band is not None else None
+        self._impulse_data = self.pinocchio.model.createData()
+        self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
 
     def _disturbance_observer(self) -> DisturbanceObserver | None:
         """With the ``disturbance`` stage, the observer of the model's steady error on its
@@ -670,11 +678,14 @@ class MpcRider(Controller):
             return None, f"WbcFailed: {exc}"
         except RidempcError as exc:
             return None, f"{type(exc).__name__}: {exc}"
+        pushed = self._pushed(estimate, sensors.time)
         if self._plan.fallback:
             return out, f"MPC plan failed (status {self._plan.status})"
         slack = self._diagnostics.get("wbc_slack", 0.0)
         if slack > 0.0:
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
+        if pushed is not None:
+            return out, pushed
         if self._deviation > HANDOVER_DEVIATION:
             return out, f"state {self._deviation:.2g} of its tolerances from the reference"
         if not self._probation.proven and self._divergence.value > HANDOVER_DEVIATION:
@@ -683,6 +694,20 @@ class MpcRider(Controller):
                 f"growing at {self._divergence.rate:.2g}/s"
             )
         return out, None
+
+    def _pushed(self, estimate: EstimatedState, now: float) -> str | None:
+        """Why a push is beyond what the MPC rides (:mod:`~ridempc.mpc.impulse`), or None;
+        the observer's window restarts while the backup rides (its forces are not the
+        whole-body QP's)."""
+        if self.impulse is None or self._push_trigger is None:
+            return None
+        if self.handover.on_backup:
+            self.impulse.reset()
+            return None
+        velocity = com_velocity(self.pinocchio.model, self._impulse_data, estimate.q, estimate.v)
+        impulse = self.impulse.update(now, velocity, self._contact_force)
+        self._diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
+        return self._push_trigger(impulse)
 
     def _fit(self) -> bool:
         """Whether the MPC may ride again: its plan solved (not the last one shifted) and
@@ -1251,6 +1276,7 @@ class MpcRider(Controller):
             posture=posture,
         )
         out = self.wbc.solve(estimate, targets)
+        self._contact_force = out.forces.sum(axis=0)
         if self.shoes is not None:
             self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
@@ -1302,6 +1328,8 @@ class MpcRider(Controller):
         out["wbc_slack_max"] = self._wbc_slack_max
         out["fallbacks"] = self.handover.summary()
         out["deviation_divergent_max"] = self._divergence.peak
+        out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
+        out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
         out["safe_hold"] = (
             None
             if self._hold_reason is None
