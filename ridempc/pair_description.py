@@ -198,6 +198,7 @@ class DisturbanceStage(_Frozen):
 
 class ImpulseStage(_Frozen):
     band: Speed = Field(description="Largest unexplained velocity change the MPC rides [m/s].")
+    sideways: Speed | None = Field(default=None, description="The same across it [m/s].")
 
 
 class Stages(_Frozen):

@@ -108,6 +108,17 @@ def test_the_trigger_fires_only_beyond_its_band() -> None:
         ImpulseTrigger(0.0)
 
 
+def test_the_sideways_band_is_across_the_heading() -> None:
+    """A narrower band across the rider: a push along world y is across a rider heading
+    along x, along one heading along y."""
+    trigger = ImpulseTrigger(0.3, sideways=0.15)
+    push = np.array([0.0, 0.2, 0.0])
+    assert trigger(push, heading=0.0) is not None
+    assert trigger(push, heading=math.pi / 2) is None
+    assert trigger(np.array([0.1, 0.1, 0.0])) is None  # inside the ellipse
+    assert trigger(np.array([0.25, 0.1, 0.0])) is not None  # outside it
+
+
 def test_the_window_holds_a_whole_push() -> None:
     """The issue's push (0.2 s) is shorter than the window: its whole impulse is summed."""
     assert WINDOW_S > 0.2

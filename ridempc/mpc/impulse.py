@@ -131,24 +131,40 @@ class ImpulseObserver:
 
 
 class ImpulseTrigger:
-    """The rule: hand over when the horizontal impulse per mass exceeds ``band`` [m/s].
+    """The rule: hand over when the horizontal impulse per mass leaves an ellipse of
+    half-axes ``band`` along the rider's heading and ``sideways`` across it [m/s],
+
+    .. math:: (\\Delta v_{along} / b)^2 + (\\Delta v_{across} / b_s)^2 > 1:
+
+    a board's support differs along its travel (its wheels drive under the rider) and
+    across it (the rider's stance on the deck), and so does the push its MPC rides.
 
     Args:
-        band: The largest velocity change [m/s] the MPC rides (the pair's ``impulse.band``).
+        band: The largest velocity change [m/s] along the heading the MPC rides (the pair's
+            ``impulse.band``).
+        sideways: The same across it [m/s] (None: ``band``).
     """
 
-    def __init__(self, band: float) -> None:
-        if band <= 0.0:
-            raise ValueError(f"band must be positive, got {band}")
+    def __init__(self, band: float, sideways: float | None = None) -> None:
+        sideways = band if sideways is None else sideways
+        if band <= 0.0 or sideways <= 0.0:
+            raise ValueError(f"bands must be positive, got {band} and {sideways}")
         self.band = band
+        self.sideways = sideways
 
-    def __call__(self, impulse: Array) -> str | None:
-        """Why the MPC cannot ride ``impulse`` [m/s] (world frame), or None if it can."""
-        size = _horizontal(impulse)
-        if size <= self.band:
+    def __call__(self, impulse: Array, heading: float = 0.0) -> str | None:
+        """Why the MPC cannot ride ``impulse`` [m/s] (world frame) with the rider heading
+        ``heading`` [rad] (world yaw), or None if it can."""
+        c, s = math.cos(heading), math.sin(heading)
+        along = c * impulse[0] + s * impulse[1]
+        across = -s * impulse[0] + c * impulse[1]
+        if math.hypot(along / self.band, across / self.sideways) <= 1.0:
             return None
-        towards = math.degrees(math.atan2(impulse[1], impulse[0]))
-        return f"pushed by {size:.2g} m/s towards {towards:.0f} deg (band {self.band:g} m/s)"
+        towards = math.degrees(math.atan2(across, along))
+        return (
+            f"pushed by {_horizontal(impulse):.2g} m/s towards {towards:.0f} deg of its heading "
+            f"(bands {self.band:g} along, {self.sideways:g} across)"
+        )
 
 
 def _horizontal(impulse: Array) -> float:

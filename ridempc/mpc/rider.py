@@ -76,7 +76,8 @@ fails, anything raises, the estimate is not finite, or the state strays beyond
 :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, or will be within a
 divergence time at the rate it grows beyond what its plan expects, until the MPC has held
 the rider settled since the start or its last return (:mod:`~ridempc.mpc.divergence`),
-the ride is handed to
+or a push from outside changes the rider's velocity beyond the pair's ``impulse`` band
+(:mod:`~ridempc.mpc.impulse`), the ride is handed to
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
@@ -539,10 +540,10 @@ class MpcRider(Controller):
         )
         self._diagnostics: dict[str, float] = {}
         # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
-        band = stages.impulse.band if stages.impulse is not None else None
+        bands = stages.impulse
         mass = self.wbc.model.mass  # [kg] the rider's, as modelled
-        self.impulse = ImpulseObserver(mass) if band is not None else None
-        self._push_trigger = ImpulseTrigger(band) if band is not None else None
+        self.impulse = ImpulseObserver(mass) if bands is not None else None
+        self._push_trigger = ImpulseTrigger(bands.band, bands.sideways) if bands else None
         self._impulse_data = self.pinocchio.model.createData()
         self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
 
@@ -707,7 +708,8 @@ class MpcRider(Controller):
         velocity = com_velocity(self.pinocchio.model, self._impulse_data, estimate.q, estimate.v)
         impulse = self.impulse.update(now, velocity, self._contact_force)
         self._diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
-        return self._push_trigger(impulse)
+        heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
+        return self._push_trigger(impulse, heading)
 
     def _fit(self) -> bool:
         """Whether the MPC may ride again: its plan solved (not the last one shifted) and
