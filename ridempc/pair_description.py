@@ -207,6 +207,11 @@ class TakeoverStage(_Frozen):
     longest_wait: Positive = Field(le=60.0, description="The MPC takes over by then [s].")
 
 
+class ImpulseStage(_Frozen):
+    band: Speed = Field(description="Largest unexplained velocity change the MPC rides [m/s].")
+    sideways: Speed | None = Field(default=None, description="The same across it [m/s].")
+
+
 class Stages(_Frozen):
     """The MPC rider's per-pair stages; a stage left out is not used."""
 
@@ -226,8 +231,8 @@ class Stages(_Frozen):
     payload: Used | None = None
     disturbance: DisturbanceStage | None = None
     takeover: TakeoverStage | None = None
-
     drop: Used | None = None
+    impulse: ImpulseStage | None = None
 
     def used(self) -> tuple[str, ...]:
         """The names of the stages used, in declaration order."""
@@ -252,8 +257,8 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "payload": (frozenset(), ()),
     "disturbance": (frozenset(), ()),
     "takeover": (frozenset(), ()),
-
     "drop": (frozenset(), ()),
+    "impulse": (frozenset(), ()),
 }
 
 

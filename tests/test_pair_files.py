@@ -169,6 +169,7 @@ def _edited(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ),
         ("cassie-segway", 'board = "segway"', 'board = "hovershoes"', "field 'robot'"),
         ("cyberdog2-skateboard", "[mpc]", "[mpc]\nhorizon = 12", "field 'mpc.horizon'"),
+        ("cassie-hovershoes", "band = 0.3", "band = -0.3", "field 'stages.impulse.band'"),
         (
             "cyberdog2-skateboard",
             'pusher = "RL_contact"',

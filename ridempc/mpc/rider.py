@@ -78,7 +78,8 @@ fails, anything raises, the estimate is not finite, or the state strays beyond
 :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, or will be within a
 divergence time at the rate it grows beyond what its plan expects, until the MPC has held
 the rider settled since the start or its last return (:mod:`~ridempc.mpc.divergence`),
-the ride is handed to
+or a push from outside changes the rider's velocity beyond the pair's ``impulse`` band
+(:mod:`~ridempc.mpc.impulse`), the ride is handed to
 the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
 estimate), the motor commands blended, and handed back once the MPC's plans have solved
 and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
@@ -127,6 +128,7 @@ from ridempc.mpc.handover import (
     deviation,
     share_estimator,
 )
+from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger, com_velocity
 from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -552,6 +554,13 @@ class MpcRider(Controller):
         if self.readiness is not None:
             self.handover.start_on_backup()
         self._diagnostics: dict[str, float] = {}
+        # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
+        bands = stages.impulse
+        mass = self.wbc.model.mass  # [kg] the rider's, as modelled
+        self.impulse = ImpulseObserver(mass) if bands is not None else None
+        self._push_trigger = ImpulseTrigger(bands.band, bands.sideways) if bands else None
+        self._impulse_data = self.pinocchio.model.createData()
+        self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
 
     def _disturbance_observer(self) -> DisturbanceObserver | None:
         """With the ``disturbance`` stage, the observer of the model's steady error on its
@@ -691,6 +700,7 @@ class MpcRider(Controller):
             return None, f"WbcFailed: {exc}"
         except RidempcError as exc:
             return None, f"{type(exc).__name__}: {exc}"
+        pushed = self._pushed(estimate, sensors.time)
         if self._plan.fallback:
             return out, f"MPC plan failed (status {self._plan.status})"
         if dropping:
@@ -698,6 +708,8 @@ class MpcRider(Controller):
         slack = self._diagnostics.get("wbc_slack", 0.0)
         if slack > 0.0:
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
+        if pushed is not None:
+            return out, pushed
         repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
         stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
         if self._deviation > HANDOVER_DEVIATION and not stroke:  # a re-push's stroke rides out
@@ -708,6 +720,21 @@ class MpcRider(Controller):
                 f"growing at {self._divergence.rate:.2g}/s"
             )
         return out, None
+
+    def _pushed(self, estimate: EstimatedState, now: float) -> str | None:
+        """Why a push is beyond what the MPC rides (:mod:`~ridempc.mpc.impulse`), or None;
+        the observer's window restarts while the backup rides (its forces are not the
+        whole-body QP's)."""
+        if self.impulse is None or self._push_trigger is None:
+            return None
+        if self.handover.on_backup:
+            self.impulse.reset()
+            return None
+        velocity = com_velocity(self.pinocchio.model, self._impulse_data, estimate.q, estimate.v)
+        impulse = self.impulse.update(now, velocity, self._contact_force)
+        self._diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
+        heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
+        return self._push_trigger(impulse, heading)
 
     def _fit(self) -> bool:
         """Whether the MPC may ride again: its plan solved (not the last one shifted) and
@@ -1287,6 +1314,7 @@ class MpcRider(Controller):
             board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
         out = self.wbc.solve(estimate, targets)
+        self._contact_force = out.forces.sum(axis=0)
         if self.shoes is not None:
             self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
@@ -1341,6 +1369,8 @@ class MpcRider(Controller):
         if self.readiness is not None:
             out["takeover"] = self.readiness.summary()
         out["deviation_divergent_max"] = self._divergence.peak
+        out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
+        out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
         out["safe_hold"] = (
             None
             if self._hold_reason is None
