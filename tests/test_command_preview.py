@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ridempc.autonomy.command_source import SourcedScenario
 from ridempc.errors import ConfigError
 from ridempc.scenarios import library_files, load_scenario_file
 from ridempc.scenarios.scenario import Command, Scenario
@@ -67,3 +68,12 @@ def test_an_unknown_field_is_refused_with_the_allowed_ones() -> None:
     scenario = Scenario.model_validate({"name": "still", "duration": 1.0})
     with pytest.raises(ConfigError, match="'speed' is not one of velocity, yaw_rate"):
         scenario.command_field_at("speed", np.zeros(3))
+
+
+def test_a_sourced_timeline_is_asked_at_each_time() -> None:
+    scenario = SourcedScenario.model_validate(
+        {"name": "sourced", "duration": 5.0, "commands": [{"t": 0.0, "velocity": 0.4}]}
+    ).with_source(lambda t: Command(velocity=0.1 * t, yaw_rate=-0.2))
+    times = np.linspace(0.0, 4.0, 17)
+    np.testing.assert_array_equal(scenario.command_field_at("velocity", times), 0.1 * times)
+    np.testing.assert_array_equal(scenario.command_field_at("yaw_rate", times), -0.2)

@@ -360,7 +360,8 @@ class Scenario(_Frozen):
     def command_field_at(self, field: str, times: NDArray[np.floating[Any]]) -> NDArray[np.float64]:
         """One field of :meth:`command_at` at each of ``times`` [s], in one call (the MPC reads
         its horizon's nodes every tick): the same arithmetic elementwise, so each value equals
-        ``getattr(self.command_at(t), field)`` to the bit.
+        ``getattr(self.command_at(t), field)`` to the bit; a subclass that answers
+        :meth:`command_at` otherwise is asked at each time.
 
         Raises:
             ConfigError: ``field`` is not a field of :class:`Command`.
@@ -370,6 +371,8 @@ class Scenario(_Frozen):
                 f"command field {field!r} is not one of {', '.join(_COMMAND_DEFAULTS)}"
             )
         times = np.asarray(times, dtype=np.float64)
+        if type(self).command_at is not Scenario.command_at:  # a timeline of its own (a planner's)
+            return np.array([getattr(self.command_at(t), field) for t in times.tolist()], float)
         values = np.full(times.shape, _COMMAND_DEFAULTS[field], dtype=np.float64)
         for event in self.commands:
             started = event.t <= times
