@@ -164,7 +164,7 @@ from ridempc.mpc.switch_blend import SwitchBlend
 from ridempc.robots.delay_margin import tracking_damping
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
-from ridempc.scenarios.scenario import Command
+from ridempc.scenarios.scenario import Command, Scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -1272,6 +1272,9 @@ class MpcRider(Controller):
         or None when the commands are not planned ahead."""
         if self.command_preview is None:
             return None
+        timeline = getattr(self.command_preview, "__self__", None)
+        if isinstance(timeline, Scenario):  # the scenario's own: all the times in one call
+            return timeline.command_field_at(field, times)
         return np.array([getattr(self.command_preview(float(t)), field) for t in times])
 
     def _speed(self, estimate: EstimatedState) -> float:

@@ -64,10 +64,13 @@ import math
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import Field, field_validator, model_validator
 
+from ridempc.errors import ConfigError
 from ridempc.robots.kind import RobotKind, robot_kind
 from ridempc.scenarios.path import PathCommand
 from ridempc.scenarios.terrain import TerrainItem, check_terrain
@@ -353,6 +356,51 @@ class Scenario(_Frozen):
         for wave in self.waves:
             values[wave.field] += wave.value(t)
         return Command.model_construct(set(values), **values)
+
+    def command_field_at(self, field: str, times: NDArray[np.floating[Any]]) -> NDArray[np.float64]:
+        """One field of :meth:`command_at` at each of ``times`` [s], in one call (the MPC reads
+        its horizon's nodes every tick): the same arithmetic elementwise, so each value equals
+        ``getattr(self.command_at(t), field)`` to the bit; a subclass that answers
+        :meth:`command_at` otherwise is asked at each time.
+
+        Raises:
+            ConfigError: ``field`` is not a field of :class:`Command`.
+        """
+        if field not in _COMMAND_DEFAULTS:
+            raise ConfigError(
+                f"command field {field!r} is not one of {', '.join(_COMMAND_DEFAULTS)}"
+            )
+        times = np.asarray(times, dtype=np.float64)
+        if type(self).command_at is not Scenario.command_at:  # a timeline of its own (a planner's)
+            return np.array([getattr(self.command_at(t), field) for t in times.tolist()], float)
+        values = np.full(times.shape, _COMMAND_DEFAULTS[field], dtype=np.float64)
+        for event in self.commands:
+            started = event.t <= times
+            if not started.any():
+                break  # in time order: no later event has started either
+            target = event._fields.get(field)
+            if target is None:
+                continue
+            if event.ramp > 0.0:
+                ramping = started & (times < event.t + event.ramp)
+                alpha = (times - event.t) / event.ramp
+                ramped = values + alpha * (target - values)
+                values = np.where(ramping, ramped, np.where(started, target, values))
+            else:
+                values = np.where(started, target, values)
+        for wave in self.waves:
+            if wave.field != field:
+                continue
+            inside = (wave.start <= times) & (times < wave.stop)
+            # math.sin, as command_at's: NumPy's sin may differ from it in the last bit
+            swing = [
+                wave.amplitude * math.sin(2.0 * math.pi * (t - wave.start) / wave.period)
+                for t in times[inside].tolist()
+            ]
+            added = np.zeros(times.shape)
+            added[inside] = swing
+            values = values + added
+        return values
 
     def with_duration(self, duration: float) -> Scenario:
         return self.model_copy(update={"duration": duration})
