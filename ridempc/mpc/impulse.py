@@ -97,12 +97,16 @@ class ImpulseObserver:
         self._baseline = np.zeros(3)  # [m/s^2] the slow residual, from before the window
         # (time [s], the step [s], the residual [m/s]) of each tick in the window
         self._samples: deque[tuple[float, float, Array]] = deque()
+        self._summed = np.zeros(3)  # [m/s] the window's residuals, summed as they come and go
+        self._span = 0.0  # [s] the window's steps, summed likewise
         self._last: tuple[float, Array, Array] | None = None  # time, velocity, force
 
     def reset(self) -> None:
         """Forget the window (the forces commanded were not the ones applied: another law
         rode); the baseline is kept."""
         self._samples.clear()
+        self._summed = np.zeros(3)
+        self._span = 0.0
         self._last = None
         self.impulse = np.zeros(3)
 
@@ -117,14 +121,18 @@ class ImpulseObserver:
             return self.impulse
         step = time - last[0]
         explained = (last[2] / self.mass + GRAVITY) * step
-        self._samples.append((time, step, velocity - last[1] - explained))
+        residual = velocity - last[1] - explained
+        self._samples.append((time, step, residual))
+        self._summed += residual
+        self._span += step
         while self._samples and self._samples[0][0] <= time - self.window_s:
             _, left, residual = self._samples.popleft()
+            self._summed -= residual
+            self._span -= left
             if self.baseline_s > 0.0:
                 share = min(1.0, left / self.baseline_s)
                 self._baseline += share * (residual / left - self._baseline)
-        summed = np.sum([r for _, _, r in self._samples], axis=0)
-        self.impulse = summed - self._baseline * sum(h for _, h, _ in self._samples)
+        self.impulse = self._summed - self._baseline * self._span
         if _horizontal(self.impulse) > self.peak:
             self.peak, self.peak_time = _horizontal(self.impulse), time
         return self.impulse
