@@ -63,3 +63,15 @@ def test_the_hovershoes_pair_uses_the_drop_and_the_others_do_not() -> None:
     assert load_pair_description("cassie", "hovershoes").stages.drop is not None
     for robot, board in (("cassie", "segway"), ("cyberdog2", "skateboard")):
         assert load_pair_description(robot, board).stages.drop is None
+
+
+def test_a_lighter_rider_s_sway_is_no_drop_but_her_fall_is() -> None:
+    """Loads are fractions of the modelled rider's share: a rider 30 % lighter stands at
+    0.7, and a sway that takes both feet to 0.55 of it is no drop; both feet at 0.3 is."""
+    detector = DropDetector()
+    standing = np.full(2, 0.7)
+    for _ in range(3000):  # [ticks] 6 s standing: the mean learns her weight
+        assert not detector.update(standing)
+    assert not any(detector.update(np.full(2, 0.55)) for _ in range(20))
+    assert not detector.update(standing)
+    assert [detector.update(np.full(2, 0.3)) for _ in range(2)] == [False, True]

@@ -9,8 +9,12 @@ landing on wheels that their firmware spun up in the air), and the ride is hande
 backup law (:mod:`ridempc.mpc.handover`), which has a flight phase of its own. A foot
 lifted on purpose (a skateboard's pushing foot) leaves the others loaded, so it is no drop.
 
-.. math:: \\text{drop} \\iff \\max_i \\ell_i < \\ell_{drop} \\text{ for } n_{drop}
-          \\text{ ticks in a row}
+.. math:: \\text{drop} \\iff \\max_i \\ell_i / \\bar\\ell < \\ell_{drop} \\text{ for }
+          n_{drop} \\text{ ticks in a row}
+
+with :math:`\\bar\\ell` the mean load per foot while standing (low-passed over
+``STANDING_TICKS``): the loads are fractions of the *modelled* rider's share, and a lighter
+rider (a payload of -30 %) stands at 0.7 of it, where a push's sway would read as a drop.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["ARM_TICKS", "DROP_LOAD", "DROP_TICKS", "DropDetector"]
+__all__ = ["ARM_TICKS", "DROP_LOAD", "DROP_TICKS", "STANDING_TICKS", "DropDetector"]
 
 # [-] every foot's load below this share of its standing load: riding, the loads sit at
 # 0.9-1.1 and one foot's swings to 0.7; rolling off a step of 171 % of a Hovershoe's wheel
@@ -30,6 +34,9 @@ DROP_TICKS: int = 2
 # standing on her platforms (the detector's loads start from a placeholder, and a ride may
 # start with the rider settling onto them).
 ARM_TICKS: int = 50
+# [ticks] the standing load's time constant, 1 s at 500 Hz: longer than a push's sway
+# (0.1-0.3 s), so the mean follows the rider's weight, not her shifts between the feet.
+STANDING_TICKS: int = 500
 
 
 class DropDetector:
@@ -48,11 +55,13 @@ class DropDetector:
         self._count = 0
         self._loaded = 0
         self._armed = False
+        self._standing = 1.0  # [-] the mean load per foot while standing (the model's: 1)
 
     def reset(self) -> None:
         self._count = 0
         self._loaded = 0
         self._armed = False
+        self._standing = 1.0
 
     def update(self, loads: NDArray[np.float64]) -> bool:
         """Take this tick's loads (one per foot, fractions of the standing share [-]);
@@ -60,9 +69,12 @@ class DropDetector:
         have all been above it for ``ARM_TICKS`` (a rider not yet standing drops nothing)."""
         if not np.size(loads):
             return False
-        loaded = float(np.min(loads)) >= self.threshold
+        limit = self.threshold * self._standing
+        loaded = float(np.min(loads)) >= limit
         self._loaded = self._loaded + 1 if loaded else 0
         self._armed = self._armed or self._loaded >= ARM_TICKS
-        low = self._armed and float(np.max(loads)) < self.threshold
+        low = self._armed and float(np.max(loads)) < limit
+        if not low:  # the standing mean learns from loaded ticks only
+            self._standing += (float(np.mean(loads)) - self._standing) / STANDING_TICKS
         self._count = self._count + 1 if low else 0
         return self._count >= self.ticks
