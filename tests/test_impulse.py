@@ -7,10 +7,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pinocchio as pin
 import pytest
 
-from ridempc.mpc.impulse import GRAVITY, WINDOW_S, ImpulseObserver, ImpulseTrigger, com_velocity
+from ridempc.mpc.impulse import GRAVITY, WINDOW_S, ImpulseObserver, ImpulseTrigger
 
 STEP = 1.0 / 500.0  # [s] the control tick
 MASS = 32.0  # [kg] a Cassie-sized rider
@@ -122,13 +121,3 @@ def test_the_sideways_band_is_across_the_heading() -> None:
 def test_the_window_holds_a_whole_push() -> None:
     """The issue's push (0.2 s) is shorter than the window: its whole impulse is summed."""
     assert WINDOW_S > 0.2
-
-
-def test_com_velocity_is_pinocchios() -> None:
-    """A free-floating body moving at 1 m/s along x: its centre of mass does too."""
-    model = pin.buildSampleModelHumanoidRandom()
-    data = model.createData()
-    q = pin.neutral(model)
-    v = np.zeros(model.nv)
-    v[0] = 1.0
-    assert com_velocity(model, data, q, v) == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)

@@ -170,6 +170,10 @@ def test_solution_obeys_dynamics_contacts_friction_and_limits(robot, springs: Sp
         )
         residual[wbc.motor_v] -= out.torque
         assert np.max(np.abs(residual[held])) < 1e-6
+        # the centre of mass's velocity it hands on (the impulse observer's) is Pinocchio's
+        data = wbc.model.model.createData()
+        pin.centerOfMass(wbc.model.model, data, q, v)
+        assert out.com_velocity == pytest.approx(data.vcom[0], abs=1e-9)
         if rigid.size:
             wanted = -settings.spring_damping * v[rigid]
             assert np.allclose(out.acceleration[rigid], wanted, atol=1e-6)
@@ -499,6 +503,7 @@ def test_motor_command_carries_torques_and_targets() -> None:
         forces=np.zeros((1, 3)),
         site_forces=np.zeros((1, 3)),
         site_positions=np.zeros((1, 3)),
+        com_velocity=np.zeros(3),
         loop_forces=np.zeros(0),
         status="solved",
         iterations=10,

@@ -123,8 +123,6 @@ Array = NDArray[np.float64]
 GRAVITY: float = 9.81  # [m] / [s]^2
 
 
-
-
 def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:
     """``wanted``, or the rotation ``limit`` [rad] from ``current`` towards it."""
     error = wanted @ current.T

@@ -16,7 +16,8 @@ made by its contact forces; a push is not. The residual of the balance over a wi
 is the velocity change [m/s] (the impulse per mass [N s/kg]) nothing the rider commanded
 explains: the generalised-momentum observer's residual on the centroidal rows, integrated
 rather than low-passed so that a short push reads as its whole impulse. :math:`\\dot c` comes
-from the state estimate and :math:`f_i` from the forces the whole-body QP commanded, so
+from the state estimate (the whole-body QP's model, evaluated there each tick) and
+:math:`f_i` from the forces the whole-body QP commanded, so
 nothing here reads the simulator's truth. Only its horizontal part is used: the pushes
 that throw a rider are horizontal, and the vertical row carries the unknown payload's weight.
 
@@ -37,7 +38,6 @@ import math
 from collections import deque
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 __all__ = [
@@ -46,7 +46,6 @@ __all__ = [
     "WINDOW_S",
     "ImpulseObserver",
     "ImpulseTrigger",
-    "com_velocity",
 ]
 
 Array = NDArray[np.float64]
@@ -58,12 +57,6 @@ WINDOW_S: float = 0.4
 # [s] the slow residual (the forces the motors realise short of the commanded ones) taken
 # off: its mean over a rider's sway (~1-2 s), long against a push
 BASELINE_S: float = 2.0
-
-
-def com_velocity(model: pin.Model, data: pin.Data, q: Array, v: Array) -> Array:
-    """The centre of mass's velocity in the world [m/s] at Pinocchio's ``q``, ``v``."""
-    pin.centerOfMass(model, data, q, v)
-    return np.array(data.vcom[0], dtype=float)
 
 
 class ImpulseObserver:

@@ -128,7 +128,7 @@ from ridempc.mpc.handover import (
     deviation,
     share_estimator,
 )
-from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger, com_velocity
+from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -559,8 +559,8 @@ class MpcRider(Controller):
         mass = self.wbc.model.mass  # [kg] the rider's, as modelled
         self.impulse = ImpulseObserver(mass) if bands is not None else None
         self._push_trigger = ImpulseTrigger(bands.band, bands.sideways) if bands else None
-        self._impulse_data = self.pinocchio.model.createData()
         self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
+        self._com_velocity = np.zeros(3)  # [m/s] at the whole-body QP's last estimate
 
     def _disturbance_observer(self) -> DisturbanceObserver | None:
         """With the ``disturbance`` stage, the observer of the model's steady error on its
@@ -730,8 +730,7 @@ class MpcRider(Controller):
         if self.handover.on_backup:
             self.impulse.reset()
             return None
-        velocity = com_velocity(self.pinocchio.model, self._impulse_data, estimate.q, estimate.v)
-        impulse = self.impulse.update(now, velocity, self._contact_force)
+        impulse = self.impulse.update(now, self._com_velocity, self._contact_force)
         self._diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
         heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
         return self._push_trigger(impulse, heading)
@@ -1318,6 +1317,7 @@ class MpcRider(Controller):
         )
         out = self.wbc.solve(estimate, targets)
         self._contact_force = out.forces.sum(axis=0)
+        self._com_velocity = out.com_velocity
         if self.shoes is not None:
             self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)

@@ -292,6 +292,7 @@ class WholeBodyController:
             forces=feet,
             site_forces=site_forces.copy(),
             site_positions=terms.sites.position,
+            com_velocity=terms.com.velocity,
             loop_forces=x[layout.loop_force].copy(),
             status=solution.status,
             iterations=solution.iterations,

@@ -168,6 +168,7 @@ class WbcOutput:
         site_forces: On each contact site [N], shape (sites, 3).
         site_positions: Where each contact site is at the estimated state [m], world, shape
             (sites, 3).
+        com_velocity: The centre of mass's velocity at the estimated state [m/s], world.
         loop_forces: Closed-chain constraint forces :math:`\\lambda` [N].
         status: OSQP's status (``solved`` or ``solved inaccurate``).
         iterations: ADMM iterations.
@@ -183,6 +184,7 @@ class WbcOutput:
     forces: Array
     site_forces: Array
     site_positions: Array
+    com_velocity: Array
     loop_forces: Array
     status: str
     iterations: int
