@@ -210,16 +210,16 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     times = now + lead + problem.dt * np.arange(problem.state_reference.shape[0])
     wanted = np.array([scenario.command_at(float(t)).roll for t in times])
     assert np.ptp(wanted) > 0.05  # the command moves over the horizon
-    roll = rider._roll_horizon(scenario.command_at(now), now)
+    roll = rider.commands.roll_horizon(scenario.command_at(now), now)
     np.testing.assert_allclose(roll, wanted)
     # the deck's roll steers the board (eq. 14): the turn it makes at 0.5 m/s, none at rest
-    gain = rider._steer_gain
+    gain = rider.commands.steer_gain
     assert gain == load_board("skateboard").params.reduced.steer_gain  # identified [1/m]
     steps = mpc.settings.horizon
-    turn = rider._roll_turn(roll, 0.5)
+    turn = rider.commands.roll_turn(roll, 0.5, names)
     np.testing.assert_allclose(turn, -gain * 0.5 * np.sin(wanted[:steps]))
-    assert not rider._roll_turn(roll, 0.0).any()
-    assert not rider._roll_turn(np.zeros_like(roll), 0.5).any()
+    assert not rider.commands.roll_turn(roll, 0.0, names).any()
+    assert not rider.commands.roll_turn(np.zeros_like(roll), 0.5, names).any()
     laid = rider.selector.with_command(problem, names, roll)
     np.testing.assert_allclose(laid.state_reference[:, names["board_roll"]], wanted)
     np.testing.assert_allclose(
@@ -227,8 +227,8 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     )
     rider.command_preview = None
     step = 1.0 / 30.0
-    rider._roll_horizon(scenario.command_at(now - step), now - step)
-    blind = rider._roll_horizon(scenario.command_at(now), now)
+    rider.commands.roll_horizon(scenario.command_at(now - step), now - step)
+    blind = rider.commands.roll_horizon(scenario.command_at(now), now)
     assert blind[0] == pytest.approx(wanted[0], abs=1e-3)  # extrapolated over the lead
     assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend
 
@@ -429,15 +429,15 @@ def test_the_cassie_riders_read_a_planned_speed_over_their_horizon(dog) -> None:
     assert horizon == pytest.approx(0.4)
     now = scenario.command_at(2.7)
     assert now.velocity == 0.0
-    assert shoes._speed_command(now, 2.7).velocity == 0.0  # no plan given yet
+    assert shoes.commands.speed_command(now, 2.7).velocity == 0.0  # no plan given yet
     for rider in (shoes, segway, skate):
         rider.command_preview = scenario.command_at
-    assert shoes._speed_command(now, 2.7).velocity == 0.5
-    assert segway._speed_command(now, 2.7).velocity == 0.5
-    ahead = shoes._speed_command(now, 2.7)
+    assert shoes.commands.speed_command(now, 2.7).velocity == 0.5
+    assert segway.commands.speed_command(now, 2.7).velocity == 0.5
+    ahead = shoes.commands.speed_command(now, 2.7)
     assert ahead.yaw_rate == now.yaw_rate  # only the speed is read ahead
-    assert shoes._speed_command(scenario.command_at(2.55), 2.55).velocity == 0.0
-    assert skate._speed_command(now, 2.7).velocity == 0.0  # the skateboard does not preview
+    assert shoes.commands.speed_command(scenario.command_at(2.55), 2.55).velocity == 0.0
+    assert skate.commands.speed_command(now, 2.7).velocity == 0.0  # the skateboard does not preview
     assert shoes.summary()["speed_preview_s"] == pytest.approx(0.4)  # the summary says so
     assert skate.summary()["speed_preview_s"] == 0.0
 

@@ -98,27 +98,22 @@ import time
 from concurrent.futures import Future
 from dataclasses import replace
 from functools import cache, partial
-from typing import Any, NamedTuple, cast
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.boards.board import Board
 from ridempc.boards.canonical import BoardState, board_state_columns
-from ridempc.boards.hovershoes.parameters import HovershoesParameters
-from ridempc.boards.skateboard.reduced import yaw_rate
-from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.delay import predicted_start
-from ridempc.mpc.disturbance import DisturbanceObserver, disturbance_rows
 from ridempc.mpc.divergence import DivergentDeviation, Probation
 from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
-from ridempc.mpc.guidance import steer_onto_lines
 from ridempc.mpc.handover import (
     HANDOVER_DEVIATION,
     RETURN_DEVIATION,
@@ -129,7 +124,6 @@ from ridempc.mpc.handover import (
     share_estimator,
 )
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
-from ridempc.mpc.input_rate import hold_first_input
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HOLD,
@@ -143,8 +137,8 @@ from ridempc.mpc.pairs import check_library_names, load_mpc_pair
 from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
+from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.push_gain import shifted_speeds
 from ridempc.mpc.push_handover import deviation_deferred
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.readiness import start_readiness
@@ -155,16 +149,22 @@ from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
+from ridempc.mpc.stages.base import DriftSource, MpcTick, ProblemShaper
+from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper, ShoeLines
+from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
+from ridempc.mpc.stages.commands import CommandHorizon
+from ridempc.mpc.stages.deck_roll import DeckSides, RollDrift, StanceRoll, side_feet
+from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observer
+from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
+from ridempc.mpc.stages.payload_models import PayloadModels
 from ridempc.mpc.stagger import standby_phase
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
-from ridempc.mpc.statics import StaticShift
 from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
-from ridempc.mpc.switch_blend import SwitchBlend
 from ridempc.robots.delay_margin import tracking_damping
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
-from ridempc.scenarios.scenario import Command, Scenario
+from ridempc.scenarios.scenario import Command
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -174,7 +174,6 @@ from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skateboard import skateboard_model
 from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
 from ridempc.wbc.controller import motor_posture
-from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.settings import WbcSettings
 from ridempc.wbc.torque_lead import TorqueLead
@@ -199,67 +198,6 @@ STANDBY_WARMUP_S: float = 1.0
 PROCESS_MIN_LATENCY: int = 2
 
 
-class _BuildInputs(NamedTuple):
-    """What an MPC problem is built from, as the loop has it at the MPC's tick: the
-    reference's time [s], the mapped state, the rates' drift (or None), the tick's time
-    [s], the board's speed [m/s], the commanded roll at the horizon's nodes [rad], the
-    turn over its steps [rad/s], the turn so far [rad], whether the rider coasts, whether
-    the manoeuvre switched at this tick, the lean loop (a copy, or None), the shoes'
-    observer (frozen, or None), the manoeuvre's kind and target, the plan in force's
-    first input (or None), the contacts of the last MPC step, the reference tracked
-    when it changed at this tick (else None), whether any manoeuvre began at this tick,
-    and the commanded lateral offset of the feet [m] (:mod:`~ridempc.mpc.foot_spread`);
-    and the delay [s] from the tick to the plan's take-up over which ``x0`` is predicted
-    (:mod:`~ridempc.mpc.delay`; ``t_ref`` and ``now`` are then the take-up's)."""
-
-    t_ref: float
-    x0: Array
-    drift: Array | None
-    now: float
-    speed: float
-    roll: Array
-    turn: Array
-    turned: float
-    coasting: bool
-    switched: bool
-    lean: LeanSteering | None
-    shoes: ShoeObserver | None
-    manoeuvre: tuple[str, float]
-    first_input: Array | None
-    contacts: tuple[Contact, ...]
-    reference: MotionReference | None
-    began: bool
-    lateral_offset: float
-    delay: float = 0.0
-
-
-class _Built(NamedTuple):
-    """An MPC problem built and solved (:meth:`MpcRider._build_and_run`): its plan, the
-    contacts of its first step, the time spent building it [s], the QP's failures so far,
-    the problem (None when sent back from the solver process without it) and how far its
-    initial state lies from its reference (:func:`~ridempc.mpc.handover.deviation`) and how
-    far its plan's next state lies from the next reference [-]."""
-
-    plan: Plan
-    contacts: tuple[Contact, ...]
-    build_s: float
-    failures: int
-    problem: MpcProblem | None
-    deviation: float
-    expected: float
-
-
-class _PendingSolve(NamedTuple):
-    """An MPC solve under way: the library frame its problem is in, the time of the state
-    it starts from [s], the tick its plan takes over, and its built and solved problem to
-    come (None when built and solved in the tick)."""
-
-    frame: PlanarFrame
-    time: float
-    due: int
-    reply: Future[_Built] | Reply[_Built] | None = None
-
-
 def _backup(robot: Robot, board: str) -> Controller:
     """The registry's :data:`BACKUP_LAW` for ``robot`` on ``board``."""
     from ridempc.controllers.registry import CONTROLLERS  # the registry imports this module
@@ -273,41 +211,6 @@ def _solver_thread() -> SolverThread:
     (made at its first use): a rider per ride, and rides one after another (``compare``'s
     seeds), would otherwise each leave an idle thread behind."""
     return SolverThread("mpc")
-
-
-def platform_feet(robot: Robot, platforms: int) -> tuple[tuple[str, ...], ...]:
-    """Feet per platform: one each when the board has a platform per foot, else all on one."""
-    feet = robot.params.foot_bodies
-    if platforms == len(feet):
-        return tuple((foot,) for foot in feet)
-    return (feet,)
-
-
-def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
-    """The platforms that the rider's push moves, as the WBC sees them: each Hovershoe, the
-    bare shoe with its identified drive (:mod:`ridempc.wbc.platforms`); the skateboard's deck,
-    its translating mass with no drive (3.2 kg under a 9 kg dog: taken for ground, the deck
-    feet would push it past its plan as the pusher returns); none otherwise."""
-    features = board.kind.features if board is not None else frozenset()
-    if board is not None and "deck_roll" in features:
-        return (RollingPlatform(mass=skateboard_model(board).mass, drive=0.0),)
-    if board is None or "shoes" not in features:
-        return ()
-    shoes = cast(HovershoesBoard, wheeled_board(board))
-    params = cast(HovershoesParameters, board.params)
-    shoe = RollingPlatform(
-        mass=shoes.shoe_mass,
-        drive=shoes.reduced.c4,
-        tread=params.wheel_width,
-        height=params.platform_height,
-    )
-    return (shoe,) * shoes.n_platforms
-
-
-def _to_deck(yaw: float, planar: Array) -> Array:
-    """Horizontal vectors [m] (..., 2), world axes, in the deck's (along, across) axes."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.asarray(planar, dtype=float) @ np.array([[c, -s], [s, c]])
 
 
 class MpcRider(Controller):
@@ -410,7 +313,8 @@ class MpcRider(Controller):
         # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
         self.crouch = Crouch.of(robot, board)
         self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
-        self.disturbance = self._disturbance_observer()  # offset-free MPC (mpc/disturbance.py)
+        # offset-free MPC (mpc/disturbance.py)
+        self.disturbance = disturbance_observer(self.pair, self.mpc.reference.state_names)
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_pair(reference.state_names, self.pair)
@@ -484,10 +388,14 @@ class MpcRider(Controller):
         rolls = stages.roll_steering is not None or stages.roll_observer is not None
         deck = skateboard_model(loaded).reduced if loaded is not None and rolls else None
         steers = deck if stages.roll_steering is not None else None
-        self._steer_gain = steers.steer_gain if steers is not None else None
-        # a yaw-rate command steered by the deck's roll, eq. (14) inverted
-        self.roll_steering = RollSteering(gain=steers.steer_gain) if steers is not None else None
-        self._blend: SwitchBlend | None = None  # a re-push's reference blended in
+        self.commands = CommandHorizon(  # the commands read over the horizon
+            self,
+            self.mpc.settings,
+            self.pair.roll_lead,
+            self.steers,
+            steers.steer_gain if steers is not None else None,
+            self.pair.speed_preview,
+        )
         gain = self.pair.roll_observer
         roll, roll_rate = BoardState(0, "roll"), BoardState(0, "roll_rate")  # the deck's
         self.roll_observer = (
@@ -500,10 +408,11 @@ class MpcRider(Controller):
             if self.roll_observer is not None and self.pair.stance_roll is not None
             else None
         )
-        # Feet per side of the deck for a rider standing on it on two sides of feet (a
-        # quadruped's two), 0 for one foot a side: the roll observer's and the stance's sides.
-        n_feet = len(robot.params.foot_bodies)
-        self._side_feet = n_feet // 2 if n_feet >= 4 and n_feet % 2 == 0 else 0
+        sides = DeckSides(self.mpc, self.pair.weight, side_feet(len(robot.params.foot_bodies)))
+        self._deck_sides = sides
+        self.stance_roll = (
+            StanceRoll(self.stance, sides, self.map.com) if self.stance is not None else None
+        )
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -514,8 +423,6 @@ class MpcRider(Controller):
         self._plan_frame = PlanarFrame()
         self._last_problem: MpcProblem | None = None
         self._plan_time = 0.0
-        self._command_roll: tuple[float, float] | None = None
-        self._lean_shift: tuple[tuple[str, float], StaticShift] | None = None
         self._turned = 0.0  # [rad] the commanded yaw rate integrated over the ride
         self._turn_time: float | None = None
         self._turn_rate = 0.0
@@ -526,8 +433,8 @@ class MpcRider(Controller):
         self._mpc_ms: list[float] = []  # each tick: building the problem and solving it
         self._mpc_qp_ms: list[float] = []  # each tick's QP: updating it and solving it
         self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
-        self._pending: _PendingSolve | None = None
-        self._worker: SolverProcess[_BuildInputs, _Built] | None = None
+        self._pending: PendingSolve | None = None
+        self._worker: SolverProcess[BuildInputs, Built] | None = None
         self._sent_reference: MotionReference | None = None  # the last one the build got
         self._mpc_failures = 0  # the MPC's fallbacks, as of the last plan taken up
         self._wbc_ms: list[float] = []
@@ -561,34 +468,50 @@ class MpcRider(Controller):
         self._push_trigger = ImpulseTrigger(bands.band, bands.sideways) if bands else None
         self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
         self._com_velocity = np.zeros(3)  # [m/s] at the whole-body QP's last estimate
-
-    def _disturbance_observer(self) -> DisturbanceObserver | None:
-        """With the ``disturbance`` stage, the observer of the model's steady error on its
-        velocity rows (:mod:`~ridempc.mpc.disturbance`)."""
-        stage = self.pair.description.stages.disturbance
-        if stage is None:
-            return None
-        names = self.mpc.reference.state_names
-        rows, angular = disturbance_rows(names, self.pair.board_states, stage.rows)
-        planar = (names.index("vx"), names.index("vy")) if "vx" in names else None
-        return DisturbanceObserver(
-            rows, angular, stage.time_constant, stage.max_linear, stage.max_angular, planar
+        self.payload_models = (
+            PayloadModels(
+                self.payload,
+                (self.pinocchio.model, self.wbc.model.model),
+                self.map.com,
+                self.layout.names["vz"],
+            )
+            if self.payload is not None
+            else None
         )
+        # the stages, each list in the order its stages act (ridempc/mpc/stages/base.py)
+        self.drifts: tuple[DriftSource, ...] = self._drift_sources()
+        self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
 
-    def _observe_disturbance(self, x0: Array, now: float, balancing: bool) -> Array:
-        """The disturbance estimated from the last plan's prediction of ``x0``
-        (:mod:`~ridempc.mpc.disturbance`), as a drift of the MPC's rates: estimated while
-        balancing (holding or coasting), held through a manoeuvre (its accelerations are
-        not a constant disturbance: estimated through ``velocity-steps``' speed changes the
-        Hovershoes fell) and while the backup law rides (the plan is not followed)."""
-        observer = self.disturbance
-        assert observer is not None
-        turn = math.remainder(self.map.frame.yaw - self._plan_frame.yaw, 2.0 * math.pi)
-        elapsed, dt = now - self._plan_time, self.mpc.settings.dt
-        hold = self.handover.on_backup or self._pending is not None or not balancing
-        observer.update(x0, self._plan, now, elapsed, dt, turn, hold)
-        self._diagnostics["disturbance_max"] = float(np.max(np.abs(observer.estimate), initial=0))
-        return observer.drift(len(x0))
+    def _drift_sources(self) -> tuple[DriftSource, ...]:
+        """The disturbance observers whose drifts the MPC's rates carry, in the order they
+        are summed: the deck's torque, the payload, the steady disturbance, the lean's."""
+        dt, names = self.mpc.settings.dt, self.layout.names
+        observer, sides = self.roll_observer, self._deck_sides
+        sources: tuple[DriftSource | None, ...] = (
+            RollDrift(observer, sides, dt) if observer is not None else None,
+            self.payload_models,
+            SteadyDrift(self.disturbance, dt) if self.disturbance is not None else None,
+            LeanDrift(self.lean, names["vy"]) if self.lean is not None else None,
+        )
+        return tuple(source for source in sources if source is not None)
+
+    def _problem_shapers(self) -> tuple[ProblemShaper, ...]:
+        """The problem shapers, in the order they act: the manoeuvre's (coasting, the
+        commanded roll, a re-push's blend, the turn), then the board's (the crouch, the
+        lean, the shoes' lines and drags, the swing's held forces)."""
+        mpc, layout, step = self.mpc, self.layout, self.pair.swing_force_step
+        blend = RepushBlend(mpc, layout)
+        shapers: tuple[ProblemShaper | None, ...] = (
+            Coasting(layout, blend),
+            RollCommand(mpc, layout),
+            blend,
+            Turn(layout),
+            CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
+            LeanShaper(mpc, layout) if self.lean is not None else None,
+            ShoeLines(self._shoe_columns, self._guidance) if self.shoes is not None else None,
+            HeldForces(mpc, step) if step is not None else None,
+        )
+        return tuple(shaper for shaper in shapers if shaper is not None)
 
     def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
         """With the ``shoe_observer`` stage (Hovershoes), the observer of where each foot
@@ -684,9 +607,8 @@ class MpcRider(Controller):
         dropping = self._drop is not None and self._drop.update(self.estimator.contact.last_load)
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
-        if self.payload is not None:
-            loads = self.estimator.contact.last_load
-            self.payload.accumulate(loads, estimate.contact, sensors.motor_torque, sensors.imu)
+        if self.payload_models is not None:
+            self.payload_models.observe(self.estimator.contact.last_load, estimate, sensors)
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
@@ -758,7 +680,7 @@ class MpcRider(Controller):
         # the rider (velocity-steps fell at 19.9 s).
         rider_speed = self.map.rider_speed(estimate)
         wanted = self.selector.select(
-            self._speed_command(command, now), self.manoeuvre, now, rider_speed
+            self.commands.speed_command(command, now), self.manoeuvre, now, rider_speed
         )
         if wanted is self.manoeuvre and self._coasting(self.manoeuvre.reference_time(now)):
             wanted = self.selector.repush(command, wanted, now, speed)  # slowed: push again
@@ -770,7 +692,7 @@ class MpcRider(Controller):
             if wanted.kind == REPUSH and self.push_side is not None:
                 self.mpc.reference = self.push_side.reference(
                     self.mpc.reference,
-                    self._yaw_rate_ahead(command, now, first_stride(self.mpc.reference)),
+                    self.commands.yaw_rate_ahead(command, now, first_stride(self.mpc.reference)),
                     self.pair.board_states,
                 )
             reference = self.mpc.reference
@@ -793,16 +715,31 @@ class MpcRider(Controller):
             if self.handover.starting and self.manoeuvre.kind == HOLD:  # the frame on the
                 self._anchor(estimate, now, self._turned)  # board while the backup holds it
         t_ref = self.manoeuvre.reference_time(now)
-        names, roll = self.layout.names, self._roll_horizon(command, now)
+        roll = self.commands.roll_horizon(command, now)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
-        self._absorb_payload(estimate, balancing)
+        held = self.handover.on_backup or self._pending is not None  # the plan not followed
+        tick = MpcTick(
+            estimate,
+            now,
+            speed,
+            balancing,
+            self._plan,
+            self._plan_time,
+            0.0,
+            held,
+            self._diagnostics,
+        )
+        if self.payload_models is not None:
+            self.payload_models.absorb(tick)
         pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
         if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
-            roll = roll + self._steering_roll(command, now, speed)
-        roll = self._stance_roll(roll, estimate, now, balancing)
-        turn = self._yaw_rate_horizon(command, now) + self._roll_turn(roll, speed)
+            roll = roll + self.commands.steering_roll(command, now, speed)
+        if self.stance_roll is not None:
+            roll = self.stance_roll(roll, tick)
+        turn = self.commands.yaw_rate_horizon(command, now)
+        turn = turn + self.commands.roll_turn(roll, speed, self.layout.names)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
         if self.shoes is not None:  # the frame follows platform 0 onto its spread line
             here = spread_lines(here[None, :], self._shoe_columns, command.lateral_offset)[0]
@@ -813,22 +750,17 @@ class MpcRider(Controller):
         self._follow_board(mapped, here, turn, now, coasting, carried)
         x0 = self._unwrapped(self.map.state(mapped), here)
         started = time.perf_counter()
-        drift = self._roll_drift(x0, now, balancing, estimate)
-        if self.payload is not None:
-            payload = self.payload.estimate.drift(len(x0), names["vz"])
-            drift = payload if drift is None else drift + payload
-        if self.disturbance is not None:
-            observed = self._observe_disturbance(x0, now, balancing)
-            drift = observed if drift is None else drift + observed
-        if self.lean is not None:
-            centrifugal = self.lean.drift(len(x0), names["vy"], speed, yaw_rate)
-            if centrifugal is not None:
-                drift = centrifugal if drift is None else drift + centrifugal
-            self._diagnostics["lean_offset"] = self.lean.offset
+        turned = math.remainder(self.map.frame.yaw - self._plan_frame.yaw, 2.0 * math.pi)
+        tick = tick._replace(frame_turn=turned)  # the frame has moved onto the board
+        drift: Array | None = None
+        for source in self.drifts:  # the disturbance observers' drifts, summed in order
+            more = source.drift(tick, x0)
+            if more is not None:
+                drift = more if drift is None else drift + more
         # the plan starts where it takes over (mpc/delay.py): the first plan is waited for
         late = self.plan_latency > 0 and self._plan is not None and self.predicts_start
         delay = self.plan_latency / self.rate_hz if late else 0.0
-        inputs = _BuildInputs(  # what the loop's state says now, copied: the build may run
+        inputs = BuildInputs(  # what the loop's state says now, copied: the build may run
             self.manoeuvre.reference_time(now + delay),  # beside the loop's next ticks,
             x0,
             drift,  # which move the shoes' observer on
@@ -852,14 +784,14 @@ class MpcRider(Controller):
         self._sent_reference = self.mpc.reference
         # the frame the plan is in: the map's moves on at the next tick, the plan only
         # when this one takes over
-        pending = _PendingSolve(self.map.frame, now + delay, self._tick + self.plan_latency)
+        pending = PendingSolve(self.map.frame, now + delay, self._tick + self.plan_latency)
         if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
             self._adopt(pending, self._build_and_run(inputs))
         else:
             self._pending = pending._replace(reply=self._submit(inputs))
         self._mpc_main_s += time.perf_counter() - started
 
-    def _submit(self, inputs: _BuildInputs) -> Future[_Built] | Reply[_Built]:
+    def _submit(self, inputs: BuildInputs) -> Future[Built] | Reply[Built]:
         """The build and solve of ``inputs`` started where ``off_tick`` says."""
         where = self.off_tick
         process = where == "process" and self.plan_latency >= PROCESS_MIN_LATENCY
@@ -869,7 +801,7 @@ class MpcRider(Controller):
             return self._worker.submit(inputs)
         if where in ("process", "thread"):
             return _solver_thread().submit(partial(self._build_and_run, inputs))
-        future: Future[_Built] = Future()
+        future: Future[Built] = Future()
         future.set_result(self._build_and_run(inputs))
         return future
 
@@ -879,7 +811,7 @@ class MpcRider(Controller):
             self._worker.close()
             self._worker = None
 
-    def _build_and_run(self, inputs: _BuildInputs) -> _Built:
+    def _build_and_run(self, inputs: BuildInputs) -> Built:
         """The MPC problem of one tick built from ``inputs`` (and the build's own state:
         the QP and its warm start, a re-push's blend, the crouch's start, the static
         shifts kept by key) and solved; in the loop's tick, the solver thread or the
@@ -909,70 +841,19 @@ class MpcRider(Controller):
         weights, reference = problem.state_weights, problem.state_reference
         gap = deviation(problem.initial_state, reference[0], weights)
         expected = deviation(plan.states[1], reference[1], weights)
-        return _Built(plan, problem.contacts[0], build, qp.failures, problem, gap, expected)
+        return Built(plan, problem.contacts[0], build, qp.failures, problem, gap, expected)
 
-    def _build_in_process(self, inputs: _BuildInputs) -> _Built:
+    def _build_in_process(self, inputs: BuildInputs) -> Built:
         """:meth:`_build_and_run` in the solver process, its reply without the problem
         (a few hundred kB to send and read back) unless ``keeps_problems``."""
         built = self._build_and_run(inputs)
         return built if self.keeps_problems else built._replace(problem=None)
 
-    def _shaped(self, problem: MpcProblem, inputs: _BuildInputs) -> MpcProblem:
-        """``problem`` shaped by the rider's steps: coasting, the commanded roll, a
-        re-push's blend, the turn, the crouch, the lean, the shoes' lines and drags and
-        the swing's held forces."""
-        names, t_ref, speed = self.layout.names, inputs.t_ref, inputs.speed
-        if inputs.began:  # any new manoeuvre ends a re-push's blend (a re-push starts its own)
-            self._blend = None
-        # A re-push before its first push (while its blend runs) coasts too, its speeds
-        # scaled to the board's: the entry's planned body speed, faster than a deck that
-        # slows more than its model, had the MPC push the body forward and brake the deck.
-        if inputs.coasting or self._blend is not None:
-            problem = self.selector.coasting(problem, self.layout, speed)
-        elif inputs.manoeuvre[0] == REPUSH:  # from the first push: the planned gain
-            problem = shifted_speeds(problem, self.layout, speed)
-        balance = None
-        if self.selector.commands_roll(names, inputs.roll):
-            balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
-        problem = self.selector.with_command(problem, names, inputs.roll, balance)
-        if inputs.switched:
-            self._blend = SwitchBlend.at_switch(problem, self.mpc.reference, self.layout, t_ref)
-        if self._blend is not None:
-            problem = self._blend(problem, t_ref)
-            self._blend = None if self._blend.done(t_ref) else self._blend
-        problem = self.selector.with_turn(problem, self.layout, inputs.turn, inputs.turned)
-        if self.crouch is not None:
-            problem = self.crouch.lower(problem, names["com_z"], inputs.now)
-        lean = inputs.lean
-        if lean is not None:
-            if lean.offset != 0.0:
-                balance = self._lean_balance(t_ref, inputs.manoeuvre)
-                problem = lean.lean(problem, names["com_y"], names["vy"], balance)
-            problem = lean.turn(problem, self.layout)
-        if inputs.shoes is not None:  # each shoe's heading turned towards its line, its
-            columns = self._shoe_columns  # feet's place along it and its drag
-            states = spread_lines(problem.state_reference, columns, inputs.lateral_offset)
-            if self._guidance:
-                states = steer_onto_lines(states, problem.initial_state, columns)
-            states = inputs.shoes.shift_reference(states, columns)
-            c = inputs.shoes.speed_drift(problem.c, problem.dt, [v for *_, v in columns])
-            problem = replace(problem, state_reference=states, c=c)
-        return self._held_forces(problem, inputs.first_input, inputs.contacts)
-
-    def _absorb_payload(self, estimate: EstimatedState, balancing: bool) -> None:
-        """The payload estimated over the last MPC step (:mod:`~ridempc.mpc.payload`) while
-        balancing (holding or coasting; held through a manoeuvre, whose accelerations move
-        the centre of pressure off the centre of mass) put into the models the map and the
-        whole-body QP read."""
-        if self.payload is None:
-            return
-        if not balancing:
-            self.payload.reset()
-        payload = self.payload.update(estimate.q, self.map.com(estimate))
-        for joint, inertia in enumerate(payload.inertias(self.payload.nominal_inertias)):
-            self.pinocchio.model.inertias[joint] = inertia
-            self.wbc.model.model.inertias[joint] = inertia
-        self._diagnostics.update(payload_kg=payload.mass)
+    def _shaped(self, problem: MpcProblem, inputs: BuildInputs) -> MpcProblem:
+        """``problem`` shaped by the rider's problem shapers, in order (:attr:`shapers`)."""
+        for shaper in self.shapers:
+            problem = shaper(problem, inputs)
+        return problem
 
     def _adopt_pending(self) -> None:
         """The pending solve's plan taken up, once its tick has come (waiting for it if
@@ -983,7 +864,7 @@ class MpcRider(Controller):
         self._adopt(solve, solve.reply.result())
         self._mpc_main_s += time.perf_counter() - started
 
-    def _adopt(self, solve: _PendingSolve, built: _Built) -> None:
+    def _adopt(self, solve: PendingSolve, built: Built) -> None:
         """The plan of ``solve`` (its problem ``built`` and solved) in force from this tick
         on, timed from the state it was solved from."""
         plan = built.plan
@@ -1020,101 +901,6 @@ class MpcRider(Controller):
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
-
-    def _lean_balance(self, t_ref: float, manoeuvre: tuple[str, float]) -> StaticShift:
-        """How the reference's forces move per metre of the lean's offset, found once per
-        manoeuvre at its first lean (the stance does not change over a speed change on
-        the Segway; found at every tick of a ramp, where the reference moves, it took
-        1.2 ms of the MPC tick)."""
-        key = manoeuvre  # (kind, target)
-        if self._lean_shift is None or self._lean_shift[0] != key:
-            names, rider = self.layout.names, self.layout.rider_states
-            self._lean_shift = (key, self.mpc.static_shift(t_ref, names["com_y"], rider))
-        return self._lean_shift[1]
-
-    def _held_forces(
-        self, problem: MpcProblem, first_input: Array | None, last: tuple[Contact, ...]
-    ) -> MpcProblem:
-        """While a foot swings and no contact changes from the last tick (``last``), the
-        first step's deck forces drawn to the last plan's (its ``first_input``;
-        :mod:`~ridempc.mpc.input_rate`), with the pair's tolerance
-        :attr:`~ridempc.mpc.pairs.MpcPair.swing_force_step`."""
-        step, contacts = self.pair.swing_force_step, problem.contacts[0]
-        if step is None or first_input is None or Contact.SWING not in contacts or last != contacts:
-            return problem
-        index = self.mpc.reference.force_index
-        weights = np.zeros(problem.nu)
-        for i, contact in enumerate(contacts):
-            if contact is Contact.BOARD:
-                weights[index[i]] = 1.0 / step**2
-        return hold_first_input(problem, first_input, weights)
-
-    def _roll_drift(
-        self, x0: Array, now: float, balancing: bool, estimate: EstimatedState
-    ) -> Array | None:
-        """The deck's estimated disturbance torque as a drift of the MPC's rates
-        (:mod:`~ridempc.mpc.roll_observer`), in four-leg balancing (holding before a
-        push-off, or coasting after one); None elsewhere, or without a deck roll. Held,
-        not integrated, while the feet of one side are off the deck or both planned at
-        the least force: two feet on one fore-aft line do not see the deck's roll (push-off-1.0
-        seed 5 read 0.002 rad of a 0.07-0.08 rad roll, and the estimate wound up to -5 N m
-        in 0.5 s)."""
-        observer = self.roll_observer
-        if observer is None:
-            return None
-        if not balancing:
-            observer.reset()
-            return None
-        share = (now - self._plan_time) / self.mpc.settings.dt
-        hold = self._one_side_light(estimate)
-        self._diagnostics["roll_disturbance"] = observer.update(x0, self._plan, share, hold)
-        return observer.drift(len(x0))
-
-    def _least_force(self) -> float:
-        """The MPC's least force of a foot on the deck [N]."""
-        count = len(self.mpc.reference.force_index)
-        return self.mpc.reference.min_board_share * self.pair.weight / count
-
-    def _one_side_light(self, estimate: EstimatedState) -> bool:
-        """Whether both feet of one side (left or right of the deck's centre line, by their
-        estimated places) are off the deck or planned within 1 N of the least force."""
-        board, plan = estimate.board, self._plan
-        side, index = self._side_feet, self.mpc.reference.force_index
-        if board is None or plan is None or not side:
-            return False
-        if len(estimate.foot_position) != 2 * side or len(index) != 2 * side:
-            return False
-        contact = np.asarray(estimate.contact, dtype=bool)
-        light = ~contact | (plan.first_input[index[:, 2]] <= self._least_force() + 1.0)
-        across = _to_deck(board.yaw, estimate.foot_position[:, :2])[:, 1]
-        order = np.argsort(across)
-        return bool(light[order[:side]].all() or light[order[side:]].all())
-
-    def _stance_roll(
-        self, roll: Array, estimate: EstimatedState, now: float, balancing: bool
-    ) -> Array:
-        """The commanded deck roll held within what the stance can hold
-        (:mod:`~ridempc.mpc.stance`), in four-leg balancing, from the four feet's estimated
-        places (the last bounds while one is off the deck); as commanded elsewhere."""
-        limit, board = self.stance, estimate.board
-        if limit is None or board is None:
-            return roll
-        if not balancing:
-            limit.reset()
-            return roll
-        feet = np.asarray(estimate.foot_position, dtype=float)
-        four = bool(self._side_feet) and len(feet) == 2 * self._side_feet
-        if not four or not np.all(estimate.contact) or self._plan is None:
-            return np.clip(roll, *limit.last)
-        com = self.map.com(estimate)
-        centre = feet[:, :2].mean(axis=0)
-        places = _to_deck(board.yaw, feet[:, :2] - centre)
-        offset = _to_deck(board.yaw, com[:2] - centre)
-        far_share = 2.0 * self._least_force() / self.pair.weight
-        dt = now - self._plan_time
-        low, high = limit.bounds(places, offset, float(board.roll), dt, far_share)
-        self._diagnostics.update(stance_low=low, stance_high=high)
-        return np.clip(roll, low, high)
 
     def _unwrapped(self, x0: Array, reference: Array) -> Array:
         """``x0`` with each heading (the base's yaw, the platforms') [rad] within
@@ -1180,101 +966,6 @@ class MpcRider(Controller):
         ground = [f for f, c in zip(feet, support, strict=True) if c is Contact.GROUND]
         swinging = [f for f, c in zip(feet, support, strict=True) if c is Contact.SWING]
         self.estimator.set_support(ground, swinging)
-
-    def _roll_horizon(self, command: Command, now: float) -> Array:
-        """The commanded deck roll at the horizon's nodes [rad], each read the pair's
-        ``roll_lead`` ahead (the closed loop's lag): from the ``command_preview`` when the
-        ride's commands are planned, else the present command extrapolated at its rate (a
-        backward difference over the last MPC step), which tracks a moving command one
-        step late."""
-        settings = self.mpc.settings
-        times = now + self.pair.roll_lead + settings.dt * np.arange(settings.horizon + 1)
-        planned = self._planned("roll", times)
-        if planned is not None:
-            return planned
-        previous = self._command_roll
-        self._command_roll = (now, command.roll)
-        rate = 0.0
-        if previous is not None and now > previous[0]:
-            rate = (command.roll - previous[1]) / (now - previous[0])
-        return np.asarray(command.roll + rate * (times - now), dtype=float)
-
-    def _steering_roll(self, command: Command, now: float, speed: float) -> Array:
-        """The deck roll that steers the commanded yaw rate at the horizon's nodes [rad]
-        (:class:`~ridempc.boards.skateboard.steering.RollSteering`, at the board's speed
-        :math:`v` [m/s]), each read the pair's ``roll_lead`` ahead as the commanded roll
-        is; zero on a board that does not steer by its roll."""
-        settings = self.mpc.settings
-        if self.roll_steering is None:
-            return np.zeros(settings.horizon + 1)
-        times = now + self.pair.roll_lead + settings.dt * np.arange(settings.horizon + 1)
-        rates = self._planned("yaw_rate", times)
-        if rates is None:
-            rates = np.full(len(times), float(command.yaw_rate))
-        return np.array([self.roll_steering.roll(float(w), speed) for w in rates])
-
-    def _roll_turn(self, roll: Array, speed: float) -> Array:
-        """The turn a commanded deck roll steers, over the horizon's steps [rad/s]: on the
-        skateboard eq. (14), :math:`\\omega_k = -v \\sin\\varphi^*_k / K_{board}` at the
-        board's speed :math:`v` (the deck's roll is how it steers); zero elsewhere or
-        without a roll command. Held on the reference's heading instead, a rolled deck
-        rolling at 0.5 m/s fought the heading, reached half its commanded roll and then
-        twice it the other way (push-off-1.0 fell at 10.7 s in its roll phase)."""
-        steps = self.mpc.settings.horizon
-        if self._steer_gain is None or not self.selector.commands_roll(self.layout.names, roll):
-            return np.zeros(steps)
-        return np.asarray(yaw_rate(speed, roll[:steps], self._steer_gain), dtype=float)
-
-    def _yaw_rate_horizon(self, command: Command, now: float) -> Array:
-        """The commanded yaw rate over the horizon's steps [rad/s], read ahead from the
-        ``command_preview`` when the ride's commands are planned, else the present one."""
-        settings = self.mpc.settings
-        if not self.steers:
-            return np.zeros(settings.horizon)
-        planned = self._planned("yaw_rate", now + settings.dt * np.arange(settings.horizon))
-        if planned is not None:
-            return planned
-        return np.full(settings.horizon, float(command.yaw_rate))
-
-    def _yaw_rate_ahead(self, command: Command, now: float, window: tuple[float, float]) -> float:
-        """The commanded yaw rate [rad/s] averaged over ``window`` [s] from ``now``: as a
-        path follower expects to ask it (``turn_preview``), else where the ride's commands
-        are planned, else the present one."""
-        dt = self.mpc.settings.dt
-        times = now + window[0] + dt * np.arange(max(1, round((window[1] - window[0]) / dt)))
-        if self.turn_preview is not None:
-            return float(np.mean([self.turn_preview(float(t)) for t in times]))
-        planned = self._planned("yaw_rate", times)
-        return float(np.mean(planned)) if planned is not None else float(command.yaw_rate)
-
-    def _speed_preview_s(self) -> float:
-        """How far ahead the manoeuvre reads a planned speed [s]: the MPC's horizon where the
-        pair previews it and the ride's commands are planned, else 0
-        (:attr:`~ridempc.mpc.pairs.MpcPair.speed_preview`)."""
-        if not self.pair.speed_preview or self.command_preview is None:
-            return 0.0
-        return self.mpc.settings.horizon * self.mpc.settings.dt
-
-    def _speed_command(self, command: Command, now: float) -> Command:
-        """``command`` with the speed planned ``_speed_preview_s`` ahead."""
-        lead = self._speed_preview_s()
-        if lead == 0.0:
-            return command
-        assert self.command_preview is not None
-        ahead = self.command_preview(now + lead).velocity
-        if ahead == command.velocity:
-            return command
-        return command.model_copy(update={"velocity": ahead})
-
-    def _planned(self, field: str, times: NDArray[np.floating[Any]]) -> Array | None:
-        """One field of the ride's planned commands at ``times`` [s] (``command_preview``),
-        or None when the commands are not planned ahead."""
-        if self.command_preview is None:
-            return None
-        timeline = getattr(self.command_preview, "__self__", None)
-        if isinstance(timeline, Scenario):  # the scenario's own: all the times in one call
-            return timeline.command_field_at(field, times)
-        return np.array([getattr(self.command_preview(float(t)), field) for t in times])
 
     def _speed(self, estimate: EstimatedState) -> float:
         if estimate.boards:
@@ -1360,7 +1051,7 @@ class MpcRider(Controller):
                 ms = np.asarray(values)
                 out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
         out["mpc_solves"] = len(self._mpc_ms)
-        out["speed_preview_s"] = self._speed_preview_s()
+        out["speed_preview_s"] = self.commands.speed_preview_s()
         out["mpc_fallbacks"] = self._mpc_failures
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries

@@ -1,0 +1,73 @@
+"""The protocols of the rider's stages (:class:`~ridempc.mpc.rider.MpcRider`'s loop).
+
+Each per-pair mechanism the pair file names under ``[stages.*]`` is a stage of one of these
+kinds, and the rider lists and orders them in one place (its ``__init__``):
+
+- :class:`DriftSource`, a disturbance observer: at each MPC tick, a drift of the MPC's
+  rates, the error its model makes that the observer has estimated (the deck's torque, the
+  payload, a steady disturbance, the lean's centrifugal pull); the drifts are summed in the
+  order listed;
+- :class:`ProblemShaper`: one change to each MPC problem before it is solved (coasting, a
+  commanded roll, a re-push's blend, the turn, the crouch and the lean, the shoes' lines,
+  the swing's held forces), applied in order where the problem is built (the loop's tick,
+  the solver thread or the solver process, whose copy keeps a stateful shaper's state);
+- the command source (:class:`~ridempc.mpc.stages.commands.CommandHorizon`): the commands
+  read over the horizon;
+- the handover triggers (:mod:`ridempc.mpc.handover`, :mod:`ridempc.mpc.impulse`,
+  :mod:`ridempc.mpc.drop`, :mod:`ridempc.mpc.divergence`): why the MPC cannot ride.
+
+To add a stage: write its module (one concept), a class meeting the protocol, and add it to
+the rider's list of that protocol where the others are built, in the order it acts.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, NamedTuple, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from ridempc.estimation import EstimatedState
+    from ridempc.mpc.plan import Plan
+    from ridempc.mpc.problem import MpcProblem
+    from ridempc.mpc.stages.build import BuildInputs
+
+__all__ = ["DriftSource", "MpcTick", "ProblemShaper"]
+
+Array = NDArray[np.float64]
+
+
+class MpcTick(NamedTuple):
+    """What the loop has at an MPC tick (every 15th, 30 Hz) for its stages: the estimate
+    (each shoe's heading read), the time [s], the board's speed [m/s], whether the rider
+    balances (holds or coasts: no manoeuvre's accelerations), the plan in force (or None)
+    and the time it was solved from [s], the library frame's turn since that plan's [rad],
+    whether the plan is not being followed (the backup rides, or a solve is under way), and
+    the rider's diagnostics to write into."""
+
+    estimate: EstimatedState
+    now: float
+    speed: float
+    balancing: bool
+    plan: Plan | None
+    plan_time: float
+    frame_turn: float
+    held: bool
+    diagnostics: dict[str, float]
+
+
+class DriftSource(Protocol):
+    """A disturbance observer: the drift it adds to the MPC's rates at an MPC tick."""
+
+    def drift(self, tick: MpcTick, x0: Array) -> Array | None:
+        """The drift [state units/s] for the mapped state ``x0``, or None for none."""
+        ...
+
+
+class ProblemShaper(Protocol):
+    """One change to the MPC's problem before it is solved."""
+
+    def __call__(self, problem: MpcProblem, inputs: BuildInputs) -> MpcProblem:
+        """``problem`` shaped, from what the loop had at its tick (``inputs``)."""
+        ...
