@@ -1,93 +1,65 @@
 """``mpc``: the skateboard paper's pipeline (section V) riding any pair with an MPC library.
 
+The rider is a loop over stages, each of one protocol (:mod:`ridempc.mpc.stages.base`),
+built once from the pair file's ``[stages.*]`` (``pairs/<robot>-<board>.toml``) and listed,
+in the order they act, in :meth:`MpcRider.__init__` (``drifts``, ``shapers``, ``triggers``).
 Every 2 ms (500 Hz) the rider
 
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
-   board from its own feet), and its mass and centre of mass from its stance's loads
-   (:mod:`ridempc.mpc.payload`: a payload, or a lighter rider), which the map's and the
-   whole-body QP's models carry and the MPC's vertical rate takes as a drift;
-2. every 15th tick (30 Hz), maps the estimate into the library frame
-   (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto the
-   reference's line: speeds and turn rates are commanded, not a path; on a board the
-   rider cannot steer, the Segway, it also turns with the board's direction of travel)
-   and solves the linear MPC
-   (:class:`~ridempc.mpc.controller.LinearMpc`; on the Segway and the skateboard the
-   problem is built and solved in a process of its own, as the robots run their MPC beside
-   their WBC, from what the tick sends it (:meth:`MpcRider._build_and_run`, ``off_tick``;
-   on the Hovershoes in a thread), and the plan takes over two ticks (4 ms; the Hovershoes
-   one) after the MPC's tick, solved from the state predicted there by the reduced model
-   (:mod:`ridempc.mpc.delay`; the Hovershoes' from the tick's state, its time shifted: the
-   pair's ``predict_start``), waited for then whatever the machine, the ticks between
-   following the previous plan in its own library frame: the pair's ``plan_latency``) on
-   the manoeuvre the command asks for
-   (:mod:`ridempc.mpc.manoeuvre`): a push-off or a speed change follows its library
-   trajectory, then rides on steadily (on the skateboard, which only a push drives, it
-   coasts: the steady ride is slowed to the board's speed,
-   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.coasting`, and once it has slowed below
-   the command it pushes again from the rolling board, the library's ``repush``,
-   :meth:`~ridempc.mpc.manoeuvre.ManoeuvreSelector.repush`); a commanded deck roll
-   replaces the reference's roll, and on the skateboard turns the reference's heading at
-   the rate the roll steers (eq. 14), a commanded yaw rate adding the roll that steers it
-   (:mod:`ridempc.boards.skateboard.steering`); on the Segway, whose knee bar the plan cannot push,
-   the rider crouches into the robot's riding keyframe and leans into the bar: a yaw-rate
-   loop moves the reference's centre of mass sideways, and riding, the reference's
-   headings and the heading the frame follows turn at the commanded rate and the frame's
-   turn pulls the centre of mass outwards in the plan (:mod:`ridempc.mpc.lean`);
-   on the Hovershoes the MPC also sees where each foot stands along its shoe and each
-   shoe's drag, which the reduced model leaves out, as fitted from the shoes' balances by
-   :class:`~ridempc.mpc.shoe_observer.ShoeObserver` at 500 Hz, each shoe's heading is
-   read off its direction of travel where its foot's toe line has crept round on it
-   (:mod:`ridempc.mpc.shoe_heading`, at 500 Hz, for the WBC too), and each shoe's heading
-   reference is turned towards its line (:mod:`ridempc.mpc.guidance`); on the
-   skateboard, in four-leg balancing, the MPC's deck-roll row carries an integrated
-   estimate of the torque its model misses (:mod:`ridempc.mpc.roll_observer`), held while
-   the feet of one side are off the deck or at their least force, the commanded roll is
-   held to what the feet's estimated stance can hold (:mod:`ridempc.mpc.stance`), and while
-   a foot swings the first step's deck forces are drawn to the last plan's
-   (:mod:`ridempc.mpc.input_rate`);
-3. turns the plan into whole-body targets, interpolated between the plan's first two nodes
-   over the 1/30 s step: centre of mass :math:`c^*(t)` and velocity, base orientation from
-   the Z-Y-X angles, where the pair asks for it (``wbc.feedforward``) the plan's
-   first-step accelerations :math:`(v_1 - v_0)/\\Delta t` and
-   :math:`(\\omega_1 - \\omega_0)/\\Delta t` fed forward, the first input's contact forces
-   (summed per foot; on the Hovershoes low-passed from solve to solve,
-   :mod:`ridempc.mpc.force_filter`), the feet in
-   contact as the schedule has them over the step, and, for a foot the schedule lifts, a
-   swing target where the reference puts it, carried by the estimated board
-   (:mod:`ridempc.mpc.swing`), and on the Hovershoes each shoe's fitted drag as its
-   rolling platform's acceleration (:meth:`~ridempc.mpc.shoe_observer.ShoeObserver.drift`);
-   and solves the 500 Hz whole-body QP
-   (:class:`~ridempc.wbc.WholeBodyController`, its posture task holding the reference's
-   joint angles where the library has them, the dog's, else the robot's riding posture
-   on the board, its stance unless a riding keyframe is given: the stance would hold the
-   dog's trunk above the reference's crouch). A foot the
-   schedule puts on the ground (a push-off) stands on the ground for the WBC and the
-   estimator, not on the board; a foot it lifts is left out of the board's estimate even
-   if it touches something;
-4. sends the QP's torques as feedforward, each led over its motor's torque delay
-   (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD, at the
-   pair's ``tracking_gain_scale`` of its default stiffnesses; a delayed motor's damping is
-   the one of largest phase margin for that stiffness at the joint's inertia in the riding
-   posture (:func:`~ridempc.robots.delay_margin.tracking_damping`), the others' the same
-   scale of their default damping.
+   board from its own feet), each shoe's heading from its direction of travel
+   (:mod:`~ridempc.mpc.shoe_heading`), and reads the stance's loads for the payload
+   (:mod:`~ridempc.mpc.stages.payload_models`) and the platforms falling away
+   (:mod:`~ridempc.mpc.drop`);
+2. every 15th tick (30 Hz), chooses the manoeuvre the command asks for
+   (:mod:`~ridempc.mpc.manoeuvre`: a push-off or a speed change follows its library
+   trajectory, then rides on; on the skateboard it coasts and pushes again), reads the
+   commands over the horizon (the command source,
+   :class:`~ridempc.mpc.stages.commands.CommandHorizon`; on the skateboard a yaw rate
+   steered by the deck's roll, within what the stance holds,
+   :class:`~ridempc.mpc.stages.deck_roll.StanceRoll`), maps the estimate into the library
+   frame (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto
+   the reference's line, and on the Segway turns with its direction of travel), sums the
+   **drift sources** (disturbance observers: the deck's torque, the payload, the steady
+   disturbance, the lean's pull; :mod:`~ridempc.mpc.stages.deck_roll`,
+   :mod:`~ridempc.mpc.stages.drifts`) into the MPC's rates, and builds the linear MPC's
+   problem (:class:`~ridempc.mpc.controller.LinearMpc`) shaped by the **problem shapers**
+   in order (:mod:`~ridempc.mpc.stages.manoeuvre_shapers`: coasting, the commanded roll, a
+   re-push's blend, the turn; :mod:`~ridempc.mpc.stages.board_shapers`: the Segway's crouch
+   and lean, the Hovershoes' lines and drags, the swing's held forces). It is solved in the
+   tick, the solver thread or a process of its own (``off_tick``), from the state
+   predicted at the plan's take-up ``plan_latency`` ticks later (:mod:`ridempc.mpc.delay`;
+   else the tick's, its time shifted: the pair's ``predict_start``), waited for then
+   whatever the machine, the ticks between following the previous plan in its own frame;
+3. turns the plan into whole-body targets (:class:`~ridempc.mpc.plan_targets.PlanReader`:
+   the plan interpolated over the 1/30 s step, its first input's forces, low-passed on the
+   Hovershoes, :mod:`~ridempc.mpc.force_filter`; the feet's support and swing,
+   :mod:`~ridempc.mpc.stages.feet_targets`; each shoe's drag as its platform's
+   acceleration) and solves the 500 Hz whole-body QP
+   (:class:`~ridempc.wbc.WholeBodyController`, :mod:`ridempc.mpc.rider_wbc`);
+4. asks the **handover triggers** in order (:mod:`~ridempc.mpc.stages.triggers`) why the
+   MPC cannot ride, and sends the QP's torques as feedforward, each led over its motor's
+   torque delay (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD
+   (:func:`~ridempc.mpc.rider_wbc.tracking_gains`).
 
-**Fallback.** The whole-body QP always returns a command (slack on its soft rows where it
-has no solution as posed, :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its
-previous plan shifted by one step is then used), the whole-body QP needs slack or still
-fails, anything raises, the estimate is not finite, or the state strays beyond
-:data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of its reference, or will be within a
-divergence time at the rate it grows beyond what its plan expects, until the MPC has held
-the rider settled since the start or its last return (:mod:`~ridempc.mpc.divergence`),
-or a push from outside changes the rider's velocity beyond the pair's ``impulse`` band
-(:mod:`~ridempc.mpc.impulse`), the ride is handed to
-the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC, reading the rider's
-estimate), the motor commands blended, and handed back once the MPC's plans have solved
-and its state has stayed near the reference for a while (:mod:`ridempc.mpc.handover`);
-each handover is in ``summary()``'s ``fallbacks``. With the pair's ``takeover`` stage the
-ride starts on that backup, the MPC planning beside it in a frame laid on the board and
-its payload estimate learning, and the MPC takes over once ready
-(:mod:`~ridempc.mpc.readiness`; when: ``summary()``'s ``mpc_takeover_s``). Only where the
-backup too has no finite command are the joints held where they are (``safe_hold``).
+**Fallback.** The whole-body QP always returns a command (slack on its soft rows,
+:mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its previous plan shifted by one step is
+then used), anything raises, the estimate is not finite, or a trigger gives a reason, the
+ride is handed to the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC,
+reading the rider's estimate), the motor commands blended, and handed back once the MPC's
+plans have solved and its state has stayed near the reference for a while
+(:mod:`~ridempc.mpc.handover`); each handover is in ``summary()``'s ``fallbacks``. With the
+pair's ``takeover`` stage the ride starts on that backup, the MPC planning beside it, and
+the MPC takes over once ready (:mod:`~ridempc.mpc.readiness`; ``summary()``'s
+``mpc_takeover_s``). Only where the backup too has no finite command are the joints held
+where they are (``safe_hold``).
+
+**Towards a few hundred lines.** What is left here beyond the loop: the manoeuvre's choice
+and the library frame's turn in :meth:`MpcRider._mpc_tick` (a *command source* stage of its
+own), the solve's dispatch to the tick, thread or process (:meth:`MpcRider._submit`,
+:meth:`MpcRider._build_and_run`: a solver stage beside :mod:`~ridempc.mpc.solver_process`),
+the handover's bookkeeping at a plan's take-up (:meth:`MpcRider._adopt`: divergence,
+probation, readiness, the backup's standby; an *observer* of the plans) and the wiring of
+the remaining stages in ``__init__`` (a factory per stage, read from the pair file).
 """
 
 from __future__ import annotations
@@ -98,12 +70,11 @@ import time
 from concurrent.futures import Future
 from dataclasses import replace
 from functools import cache, partial
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.boards.board import Board
 from ridempc.boards.canonical import BoardState, board_state_columns
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
@@ -115,7 +86,6 @@ from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.handover import (
-    HANDOVER_DEVIATION,
     RETURN_DEVIATION,
     RETURN_DWELL_S,
     STANDBY_DIVIDER,
@@ -143,10 +113,9 @@ from ridempc.mpc.push_handover import deviation_deferred
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
-from ridempc.mpc.riding_posture import ride_qpos
+from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
-from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
 from ridempc.mpc.stages.base import DriftSource, MpcTick, ProblemShaper
@@ -155,27 +124,25 @@ from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
 from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.mpc.stages.deck_roll import DeckSides, RollDrift, StanceRoll, side_feet
 from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observer
+from ridempc.mpc.stages.feet_targets import FeetTargets
 from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
 from ridempc.mpc.stages.payload_models import PayloadModels
+from ridempc.mpc.stages.shoes import shoe_columns, shoe_observer
+from ridempc.mpc.stages.support import contacts_to_feet, foot_support
+from ridempc.mpc.stages.triggers import HANDOVER_TRIGGERS, HandoverCheck, HandoverTrigger, PushWatch
 from ridempc.mpc.stagger import standby_phase
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
-from ridempc.mpc.swing import VELOCITY_STEP, ReferenceFeet
-from ridempc.robots.delay_margin import tracking_damping
+from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
-from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
-from ridempc.solvers import solver_for
-from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skateboard import skateboard_model
-from ridempc.wbc import WbcTargets, WholeBodyController, to_motor_command
-from ridempc.wbc.controller import motor_posture
+from ridempc.wbc import WbcTargets, to_motor_command
 from ridempc.wbc.qp import WbcFailed
-from ridempc.wbc.settings import WbcSettings
 from ridempc.wbc.torque_lead import TorqueLead
 
 __all__ = ["BACKUP_LAW", "MpcRider", "platform_feet", "rolling_platforms"]
@@ -321,41 +288,14 @@ class MpcRider(Controller):
         self.map = StateMap(
             self.pinocchio, reference.state_names, self.pair.board_states, base=self.pair.base
         )
-        # Cassie's leaf springs as rigid joints held at their deflection: as passive torques
-        # the estimator's spring deflection (about twice the true one, through the soft
-        # achilles-rod constraint) drives the QP off (see the WBC's tests).
-        # The MPC's forces weigh the pair file's ``wbc.force_weight`` (the WBC's own default
-        # is 1): their distribution over the feet is what rolls a deck or a platform, and the
-        # CoM and orientation tasks leave it free (measurements: docs/tuning.md, "Pair files").
-        sprung = bool(np.any(self.pinocchio.spring_stiffness > 0.0))
-        settings_wbc = WbcSettings(
-            springs="rigid" if sprung else "passive",
-            force_weight=tuning.force_weight,
-            pyramid=self.pair.pyramid,
-            solver=wbc_solver or solver_for("wbc"),
-        )
-        self.wbc = WholeBodyController(
-            robot,
-            settings_wbc,
-            pinocchio=self.pinocchio,
-            posture=motor_posture(self.pinocchio, robot, ride_qpos(robot, board)),
-            platforms=rolling_platforms(loaded),
-        )
+        self.wbc = rider_wbc(robot, board, loaded, self.pinocchio, self.pair, wbc_solver)
         self._feedforward = tuning.feedforward
         tau = self.pair.force_time_constant  # the forces the WBC gets, low-passed
         self.force_filter = ForceFilter(tau) if tau is not None else None
-        scale = tuning.tracking_gain_scale  # the QP's torques lead, the PD follows
-        self.kp = scale * np.array([m.kp for m in robot.motors])
-        self.kd = tracking_damping(  # each delayed loop damped at its largest margin
-            robot.mj_model,
-            ride_qpos(robot, board),
-            robot.motors,
-            self.kp,
-            scale * np.array([m.kd for m in robot.motors]),
-            1.0 / DEFAULT_PHYSICS_HZ,
-        )
+        self.kp, self.kd = tracking_gains(robot, board, tuning.tracking_gain_scale)
         self.torque_lead = TorqueLead(robot, self.wbc.settings.dt)  # sent ahead of the delay
-        self._contact_foot = self._contacts_to_feet(reference.contact_names)
+        feet = robot.params.foot_bodies  # the foot of each library contact
+        self._contact_foot = contacts_to_feet(robot.mj_model, feet, reference.contact_names)
         self._read_plan = PlanReader(
             self.layout.names,
             self.layout.base_prefix,
@@ -368,7 +308,12 @@ class MpcRider(Controller):
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
-        self.shoes = self._shoe_observer(loaded)
+        # where each foot stands along its shoe and each shoe's drag (Hovershoes)
+        self.shoes = (
+            shoe_observer(loaded, self.wbc.model, self.platform_feet)
+            if loaded is not None and stages.shoe_observer is not None
+            else None
+        )
         # each shoe's heading from its direction of travel: the soles creep round on the pads
         self.shoe_heading = (
             ShoeHeading(self.shoes.platforms)
@@ -376,15 +321,7 @@ class MpcRider(Controller):
             else None
         )
         self._guidance = stages.guidance is not None  # shoe headings turned onto their lines
-        quantities = ("x", "y", "heading", "speed")  # each shoe's, in the MPC's state
-        self._shoe_columns = (
-            tuple(
-                tuple(columns[BoardState(k, q)] for q in quantities)
-                for k in sorted({state.platform for state in columns})
-            )
-            if self.shoes is not None
-            else ()
-        )
+        self._shoe_columns = shoe_columns(columns) if self.shoes is not None else ()
         rolls = stages.roll_steering is not None or stages.roll_observer is not None
         deck = skateboard_model(loaded).reduced if loaded is not None and rolls else None
         steers = deck if stages.roll_steering is not None else None
@@ -416,6 +353,7 @@ class MpcRider(Controller):
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
+        self.feet_targets = FeetTargets(self.feet, self.wbc, self.mpc)
         self._support: tuple[Contact, ...] | None = None  # per foot, this MPC step
         self._contacts: tuple[Contact, ...] = ()  # per library contact, the last MPC step
         self._tick = 0
@@ -465,7 +403,11 @@ class MpcRider(Controller):
         bands = stages.impulse
         mass = self.wbc.model.mass  # [kg] the rider's, as modelled
         self.impulse = ImpulseObserver(mass) if bands is not None else None
-        self._push_trigger = ImpulseTrigger(bands.band, bands.sideways) if bands else None
+        self.push_watch = (
+            PushWatch(self.impulse, ImpulseTrigger(bands.band, bands.sideways))
+            if self.impulse is not None and bands
+            else None
+        )
         self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
         self._com_velocity = np.zeros(3)  # [m/s] at the whole-body QP's last estimate
         self.payload_models = (
@@ -481,6 +423,7 @@ class MpcRider(Controller):
         # the stages, each list in the order its stages act (ridempc/mpc/stages/base.py)
         self.drifts: tuple[DriftSource, ...] = self._drift_sources()
         self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
+        self.triggers: tuple[HandoverTrigger, ...] = HANDOVER_TRIGGERS
 
     def _drift_sources(self) -> tuple[DriftSource, ...]:
         """The disturbance observers whose drifts the MPC's rates carry, in the order they
@@ -513,31 +456,9 @@ class MpcRider(Controller):
         )
         return tuple(shaper for shaper in shapers if shaper is not None)
 
-    def _shoe_observer(self, board: Board | None) -> ShoeObserver | None:
-        """With the ``shoe_observer`` stage (Hovershoes), the observer of where each foot
-        stands along its shoe and of each shoe's drag."""
-        if board is None or self.pair.description.stages.shoe_observer is None:
-            return None
-        shoes = cast(HovershoesBoard, wheeled_board(board))
-        names = self.wbc.model.foot_names
-        platform_of = {foot: k for k, group in enumerate(self.platform_feet) for foot in group}
-        sites = [platform_of.get(names[f], -1) for f in self.wbc.model.site_foot]
-        return ShoeObserver(shoes, sites)
-
     def _mapped(self, estimate: EstimatedState) -> EstimatedState:
         """The estimate as the MPC sees it: each Hovershoe's origin on its axis."""
         return estimate if self.shoes is None else self.shoes.shift(estimate)
-
-    def _contacts_to_feet(self, contacts: tuple[str, ...]) -> list[int]:
-        """The foot (``foot_bodies`` index) each library contact belongs to."""
-        model = self.robot.mj_model
-        feet = list(self.robot.params.foot_bodies)
-        out = []
-        for contact in contacts:
-            site = model.site(contact)
-            body = model.body(int(site.bodyid[0])).name
-            out.append(feet.index(body))
-        return out
 
     # ------------------------------------------------------------------ loop
 
@@ -622,40 +543,28 @@ class MpcRider(Controller):
             return None, f"WbcFailed: {exc}"
         except RidempcError as exc:
             return None, f"{type(exc).__name__}: {exc}"
-        pushed = self._pushed(estimate, sensors.time)
-        if self._plan.fallback:
-            return out, f"MPC plan failed (status {self._plan.status})"
-        if dropping:
-            return out, "every foot's load gone at once (a drop)"
-        slack = self._diagnostics.get("wbc_slack", 0.0)
-        if slack > 0.0:
-            return out, f"whole-body QP infeasible (slack {slack:.3g})"
-        if pushed is not None:
-            return out, pushed
+        pushed, watch = None, self.push_watch
+        if watch is not None:  # the push from outside, from this tick's whole-body QP
+            velocity, force = self._com_velocity, self._contact_force
+            backup = self.handover.on_backup
+            pushed = watch(estimate, sensors.time, backup, velocity, force, self._diagnostics)
         repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
         stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
-        if self._deviation > HANDOVER_DEVIATION and not stroke:  # a re-push's stroke rides out
-            return out, f"state {self._deviation:.2g} of its tolerances from the reference"
-        if not self._probation.proven and self._divergence.value > HANDOVER_DEVIATION:
-            return out, (
-                f"state {self._deviation:.2g} of its tolerances from the reference, "
-                f"growing at {self._divergence.rate:.2g}/s"
-            )
+        check = HandoverCheck(
+            self._plan,
+            dropping,
+            self._diagnostics.get("wbc_slack", 0.0),
+            pushed,
+            self._deviation,
+            stroke,
+            self._probation.proven,
+            self._divergence,
+        )
+        for trigger in self.triggers:  # the first reason hands the ride over
+            reason = trigger(check)
+            if reason is not None:
+                return out, reason
         return out, None
-
-    def _pushed(self, estimate: EstimatedState, now: float) -> str | None:
-        """Why a push is beyond what the MPC rides (:mod:`~ridempc.mpc.impulse`), or None;
-        the observer's window restarts while the backup rides (its forces are not the
-        whole-body QP's)."""
-        if self.impulse is None or self._push_trigger is None:
-            return None
-        if self.handover.on_backup:
-            self.impulse.reset()
-            return None
-        impulse = self.impulse.update(now, self._com_velocity, self._contact_force)
-        self._diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
-        heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
-        return self._push_trigger(impulse, heading)
 
     def _fit(self) -> bool:
         """Whether the MPC may ride again: its plan solved (not the last one shifted) and
@@ -956,13 +865,8 @@ class MpcRider(Controller):
         estimator is told which feet stand on the ground and which swing (they say nothing
         of the board)."""
         feet = self.robot.params.foot_bodies
-        support = [Contact.SWING] * len(feet)
-        for contact, foot in zip(contacts, self._contact_foot, strict=True):
-            if contact is Contact.GROUND or support[foot] is Contact.GROUND:
-                support[foot] = Contact.GROUND
-            elif contact is Contact.BOARD:
-                support[foot] = Contact.BOARD
-        self._support = tuple(support)
+        support = foot_support(contacts, self._contact_foot, len(feet))
+        self._support = support
         ground = [f for f, c in zip(feet, support, strict=True) if c is Contact.GROUND]
         swinging = [f for f, c in zip(feet, support, strict=True) if c is Contact.SWING]
         self.estimator.set_support(ground, swinging)
@@ -976,34 +880,22 @@ class MpcRider(Controller):
         plan = self._plan
         assert plan is not None
         wanted = self._read_plan(plan, self._plan_frame, (now - self._plan_time) * 30.0)
-        frame = self._plan_frame
         assert self._support is not None  # set by the MPC tick, which runs first
-        contact = np.array([c is not Contact.SWING for c in self._support])
-        swing = swing_velocity = posture = None
-        if self.feet.plans_feet:  # the reference's feet and joint angles
-            t_ref = self.manoeuvre.reference_time(now)
-            states = self.mpc.reference.states_at(np.array([t_ref, t_ref + VELOCITY_STEP]))
-            posture = self.feet.joint_angles(states[0], self.wbc.motor_q)
-            if not contact.all():
-                board = estimate.boards[0] if estimate.boards else None
-                swing, swing_velocity = self.feet.targets(states, frame, board)
-        elif not contact.all():  # without planned feet, a lifted foot holds where it is
-            swing = self.wbc.model.foot_points(estimate.q)
-        if not contact.any():
-            contact[:] = True
+        t_ref = self.manoeuvre.reference_time(now)
+        feet = self.feet_targets(self._support, t_ref, estimate, self._plan_frame)
         targets = WbcTargets(
             position=wanted.position,
             orientation=wanted.orientation,
-            contact=contact,
+            contact=feet.contact,
             forces=wanted.forces,
             velocity=wanted.velocity,
             acceleration=wanted.acceleration,
             angular_velocity=wanted.angular_velocity,
             angular_acceleration=wanted.angular_acceleration,
             site_forces=wanted.site_forces if self._sites_match else None,
-            swing_position=swing,
-            swing_velocity=swing_velocity,
-            posture=posture,
+            swing_position=feet.swing,
+            swing_velocity=feet.swing_velocity,
+            posture=feet.posture,
             board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
         out = self.wbc.solve(estimate, targets)
