@@ -14,6 +14,7 @@ import pytest
 from ridempc.controllers.base import Controller
 from ridempc.mpc.controller import MpcSettings
 from ridempc.mpc.divergence import DivergentDeviation
+from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.stages.build import BuildInputs
@@ -21,7 +22,7 @@ from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.mpc.stages.deck_roll import side_feet, to_deck
 from ridempc.mpc.stages.manoeuvre_shapers import RepushBlend
 from ridempc.mpc.stages.support import foot_support
-from ridempc.mpc.stages.triggers import HANDOVER_TRIGGERS, HandoverCheck
+from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, handover_triggers
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
@@ -32,12 +33,21 @@ def _plan(fallback: bool = False) -> Plan:
 
 
 def _check(**changes: Any) -> HandoverCheck:
-    calm = HandoverCheck(_plan(), False, 0.0, None, 0.0, False, True, DivergentDeviation())
+    calm = HandoverCheck(_plan(), 0.0, 0.0, False, True, DivergentDeviation())
     return calm._replace(**changes)
 
 
-def _reason(check: HandoverCheck) -> str | None:
-    for trigger in HANDOVER_TRIGGERS:
+class _Pushed:
+    """A push watch that always reads a push."""
+
+    def __call__(self, check: HandoverCheck) -> str | None:
+        return "a push"
+
+
+def _reason(check: HandoverCheck, dropping: bool = False, pushed: bool = False) -> str | None:
+    drop = DropWatch(DropDetector())
+    drop.dropping = dropping
+    for trigger in handover_triggers(drop, cast(Any, _Pushed()) if pushed else None):
         reason = trigger(check)
         if reason is not None:
             return reason
@@ -46,11 +56,11 @@ def _reason(check: HandoverCheck) -> str | None:
 
 def test_the_triggers_give_the_first_reason_in_their_order() -> None:
     assert _reason(_check()) is None
-    assert "MPC plan failed" in str(_reason(_check(plan=_plan(True), dropping=True)))
-    assert "a drop" in str(_reason(_check(dropping=True, slack=0.1)))
-    assert "slack 0.1" in str(_reason(_check(slack=0.1, pushed="a push")))
-    assert _reason(_check(pushed="a push", deviation=2.0 * HANDOVER_DEVIATION)) == "a push"
+    assert "MPC plan failed" in str(_reason(_check(plan=_plan(True)), dropping=True))
+    assert "a drop" in str(_reason(_check(slack=0.1), dropping=True))
+    assert "slack 0.1" in str(_reason(_check(slack=0.1), pushed=True))
     far = 2.0 * HANDOVER_DEVIATION
+    assert _reason(_check(deviation=far), pushed=True) == "a push"
     assert "from the reference" in str(_reason(_check(deviation=far)))
     assert _reason(_check(deviation=far, stroke=True)) is None  # a re-push's stroke rides out
 

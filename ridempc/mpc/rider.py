@@ -118,7 +118,7 @@ from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
-from ridempc.mpc.stages.base import DriftSource, MpcTick, ProblemShaper
+from ridempc.mpc.stages.base import ControlTick, DriftSource, MpcTick, ProblemShaper, TickObserver
 from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper, ShoeLines
 from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
 from ridempc.mpc.stages.commands import CommandHorizon
@@ -127,9 +127,9 @@ from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observ
 from ridempc.mpc.stages.feet_targets import FeetTargets
 from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
 from ridempc.mpc.stages.payload_models import PayloadModels
-from ridempc.mpc.stages.shoes import shoe_columns, shoe_observer
+from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_columns, shoe_observer
 from ridempc.mpc.stages.support import contacts_to_feet, foot_support
-from ridempc.mpc.stages.triggers import HANDOVER_TRIGGERS, HandoverCheck, HandoverTrigger, PushWatch
+from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, PushWatch, handover_triggers
 from ridempc.mpc.stagger import standby_phase
 from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
@@ -143,6 +143,7 @@ from ridempc.trajopt.schedule import Contact
 from ridempc.trajopt.skateboard import skateboard_model
 from ridempc.wbc import WbcTargets, to_motor_command
 from ridempc.wbc.qp import WbcFailed
+from ridempc.wbc.targets import WbcOutput
 from ridempc.wbc.torque_lead import TorqueLead
 
 __all__ = ["BACKUP_LAW", "MpcRider", "platform_feet", "rolling_platforms"]
@@ -381,7 +382,7 @@ class MpcRider(Controller):
         self._divergence = DivergentDeviation()  # where that deviation is heading
         self._probation = Probation()  # whether the MPC has shown its model holds the rider
         # the platforms falling away under the feet (a step), with the ``drop`` stage
-        self._drop = DropDetector() if self.pair.description.stages.drop is not None else None
+        self.drop_watch = DropWatch(DropDetector()) if stages.drop is not None else None
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
@@ -408,8 +409,6 @@ class MpcRider(Controller):
             if self.impulse is not None and bands
             else None
         )
-        self._contact_force = np.zeros(3)  # [N] the whole-body QP's, summed over the feet
-        self._com_velocity = np.zeros(3)  # [m/s] at the whole-body QP's last estimate
         self.payload_models = (
             PayloadModels(
                 self.payload,
@@ -423,7 +422,14 @@ class MpcRider(Controller):
         # the stages, each list in the order its stages act (ridempc/mpc/stages/base.py)
         self.drifts: tuple[DriftSource, ...] = self._drift_sources()
         self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
-        self.triggers: tuple[HandoverTrigger, ...] = HANDOVER_TRIGGERS
+        self.observers: tuple[TickObserver, ...] = tuple(
+            observer for observer in (self.drop_watch, self.payload_models) if observer is not None
+        )
+        shoes = ShoeUpdate(self.shoes) if self.shoes is not None else None
+        self.wbc_observers: tuple[TickObserver, ...] = tuple(
+            observer for observer in (shoes, self.push_watch) if observer is not None
+        )
+        self.triggers = handover_triggers(self.drop_watch, self.push_watch)
 
     def _drift_sources(self) -> tuple[DriftSource, ...]:
         """The disturbance observers whose drifts the MPC's rates carry, in the order they
@@ -466,8 +472,8 @@ class MpcRider(Controller):
         self.estimator.reset(sensors)
         self.map.reset()
         self.torque_lead.reset()
-        if self._drop is not None:
-            self._drop.reset()
+        if self.drop_watch is not None:
+            self.drop_watch.reset()
         self._tick = 0
         self._plan = None
         estimate = self.estimator.state
@@ -525,11 +531,12 @@ class MpcRider(Controller):
             np.isfinite(estimate.q).all() and np.isfinite(estimate.v).all()
         ):
             return None, "state estimate not finite"
-        dropping = self._drop is not None and self._drop.update(self.estimator.contact.last_load)
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
-        if self.payload_models is not None:
-            self.payload_models.observe(self.estimator.contact.last_load, estimate, sensors)
+        loads, on_backup = self.estimator.contact.last_load, self.handover.on_backup
+        tick = ControlTick(sensors, estimate, loads, on_backup, self._diagnostics)
+        for observer in self.observers:
+            observer.observe(tick)
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
@@ -537,24 +544,20 @@ class MpcRider(Controller):
                 self._adopt_pending()
             if self._plan is None:
                 return None, "no MPC plan"
-            out = self._wbc_tick(estimate, sensors.time)
+            out, solved = self._wbc_tick(estimate, sensors.time)
         except WbcFailed as exc:
             self._wbc_failures += 1
             return None, f"WbcFailed: {exc}"
         except RidempcError as exc:
             return None, f"{type(exc).__name__}: {exc}"
-        pushed, watch = None, self.push_watch
-        if watch is not None:  # the push from outside, from this tick's whole-body QP
-            velocity, force = self._com_velocity, self._contact_force
-            backup = self.handover.on_backup
-            pushed = watch(estimate, sensors.time, backup, velocity, force, self._diagnostics)
+        tick = tick._replace(wbc=solved)
+        for observer in self.wbc_observers:
+            observer.observe(tick)
         repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
         stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
         check = HandoverCheck(
             self._plan,
-            dropping,
             self._diagnostics.get("wbc_slack", 0.0),
-            pushed,
             self._deviation,
             stroke,
             self._probation.proven,
@@ -876,7 +879,9 @@ class MpcRider(Controller):
             return forward_speed(estimate.boards[0])
         return float(np.linalg.norm(estimate.base_velocity[:2]))
 
-    def _wbc_tick(self, estimate: EstimatedState, now: float) -> MotorCommand:
+    def _wbc_tick(self, estimate: EstimatedState, now: float) -> tuple[MotorCommand, WbcOutput]:
+        """The whole-body QP's motor command for the plan in force at ``now`` [s], and its
+        output."""
         plan = self._plan
         assert plan is not None
         wanted = self._read_plan(plan, self._plan_frame, (now - self._plan_time) * 30.0)
@@ -899,15 +904,12 @@ class MpcRider(Controller):
             board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
         out = self.wbc.solve(estimate, targets)
-        self._contact_force = out.forces.sum(axis=0)
-        self._com_velocity = out.com_velocity
-        if self.shoes is not None:
-            self.shoes.update(estimate, out.site_positions, out.site_forces)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
         slack = self.wbc.last_solution.slack if self.wbc.last_solution is not None else 0.0
         self._wbc_slack_max = max(self._wbc_slack_max, slack)
         self._diagnostics.update(wbc_ms=self._wbc_ms[-1], wbc_slack=slack)
-        return to_motor_command(out, self.kp, self.kd, torque=self.torque_lead(now, out.torque))
+        torque = self.torque_lead(now, out.torque)
+        return to_motor_command(out, self.kp, self.kd, torque=torque), out
 
     # ------------------------------------------------------------------ reports
 

@@ -3,6 +3,10 @@
 Each per-pair mechanism the pair file names under ``[stages.*]`` is a stage of one of these
 kinds, and the rider lists and orders them in one place (its ``__init__``):
 
+- :class:`TickObserver`: updated every control tick (500 Hz) from the sensors, the estimate
+  and the feet's loads (``observers``: the drop's watch, the payload's loads), or, in
+  ``wbc_observers``, after the whole-body QP from its output too (the shoes' observer, the
+  push's watch);
 - :class:`DriftSource`, a disturbance observer: at each MPC tick, a drift of the MPC's
   rates, the error its model makes that the observer has estimated (the deck's torque, the
   payload, a steady disturbance, the lean's centrifugal pull); the drifts are summed in the
@@ -13,8 +17,9 @@ kinds, and the rider lists and orders them in one place (its ``__init__``):
   the solver thread or the solver process, whose copy keeps a stateful shaper's state);
 - the command source (:class:`~ridempc.mpc.stages.commands.CommandHorizon`): the commands
   read over the horizon;
-- the handover triggers (:mod:`ridempc.mpc.handover`, :mod:`ridempc.mpc.impulse`,
-  :mod:`ridempc.mpc.drop`, :mod:`ridempc.mpc.divergence`): why the MPC cannot ride.
+- :class:`~ridempc.mpc.stages.triggers.HandoverTrigger` (``triggers``): why the MPC
+  cannot ride this tick (:mod:`~ridempc.mpc.stages.triggers`), asked in order; a watch
+  that observes every tick may be a trigger too.
 
 To add a stage: write its module (one concept), a class meeting the protocol, and add it to
 the rider's list of that protocol where the others are built, in the order it acts.
@@ -32,10 +37,34 @@ if TYPE_CHECKING:
     from ridempc.mpc.plan import Plan
     from ridempc.mpc.problem import MpcProblem
     from ridempc.mpc.stages.build import BuildInputs
+    from ridempc.sim.sensors import SensorPacket
+    from ridempc.wbc.targets import WbcOutput
 
-__all__ = ["DriftSource", "MpcTick", "ProblemShaper"]
+__all__ = ["ControlTick", "DriftSource", "MpcTick", "ProblemShaper", "TickObserver"]
 
 Array = NDArray[np.float64]
+
+
+class ControlTick(NamedTuple):
+    """What the loop has at each control tick (500 Hz) for its observers: the sensors, the
+    estimate (each shoe's heading read), each foot's load [-] (a fraction of its standing
+    share), whether the backup law rides, the rider's diagnostics to write into, and this
+    tick's whole-body QP output (None before it is solved)."""
+
+    sensors: SensorPacket
+    estimate: EstimatedState
+    loads: Array
+    on_backup: bool
+    diagnostics: dict[str, float]
+    wbc: WbcOutput | None = None
+
+
+class TickObserver(Protocol):
+    """A stage updated at every control tick."""
+
+    def observe(self, tick: ControlTick) -> None:
+        """Take this tick's readings."""
+        ...
 
 
 class MpcTick(NamedTuple):

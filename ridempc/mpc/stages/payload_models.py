@@ -5,7 +5,8 @@ at each MPC tick the estimate over the last MPC step goes into the models the st
 the whole-body QP read (their links' inertias), while the rider balances (holds or coasts;
 held through a manoeuvre, whose accelerations move the centre of pressure off the centre of
 mass), and its weight the MPC's vertical rate carries as a drift
-(:class:`~ridempc.mpc.stages.base.DriftSource`).
+(:class:`~ridempc.mpc.stages.base.DriftSource`); a
+:class:`~ridempc.mpc.stages.base.TickObserver` and a drift source.
 """
 
 from __future__ import annotations
@@ -18,8 +19,7 @@ from numpy.typing import NDArray
 
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.payload import PayloadEstimator
-from ridempc.mpc.stages.base import MpcTick
-from ridempc.sim.sensors import SensorPacket
+from ridempc.mpc.stages.base import ControlTick, MpcTick
 
 __all__ = ["PayloadModels"]
 
@@ -46,9 +46,11 @@ class PayloadModels:
     ) -> None:
         self.payload, self._models, self._com, self._vz = payload, tuple(models), com, vz
 
-    def observe(self, loads: Array, estimate: EstimatedState, sensors: SensorPacket) -> None:
+    def observe(self, tick: ControlTick) -> None:
         """One control tick's reading of the stance's loads [-] and the sensors."""
-        self.payload.accumulate(loads, estimate.contact, sensors.motor_torque, sensors.imu)
+        sensors = tick.sensors
+        contact = tick.estimate.contact
+        self.payload.accumulate(tick.loads, contact, sensors.motor_torque, sensors.imu)
 
     def absorb(self, tick: MpcTick) -> None:
         """The estimate over the last MPC step (dropped unless balancing) into the models."""

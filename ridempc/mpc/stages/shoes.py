@@ -11,10 +11,11 @@ from typing import cast
 from ridempc.boards.board import Board
 from ridempc.boards.canonical import BoardState
 from ridempc.mpc.shoe_observer import ShoeObserver
+from ridempc.mpc.stages.base import ControlTick
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.wbc.model import WholeBodyModel
 
-__all__ = ["SHOE_QUANTITIES", "shoe_columns", "shoe_observer"]
+__all__ = ["SHOE_QUANTITIES", "ShoeUpdate", "shoe_columns", "shoe_observer"]
 
 # each shoe's quantities that its lines, its foot's place and its drag move, in this order
 SHOE_QUANTITIES: tuple[str, ...] = ("x", "y", "heading", "speed")
@@ -39,3 +40,16 @@ def shoe_columns(columns: Mapping[BoardState, int]) -> tuple[tuple[int, ...], ..
         tuple(columns[BoardState(k, q)] for q in SHOE_QUANTITIES)
         for k in sorted({state.platform for state in columns})
     )
+
+
+class ShoeUpdate:
+    """The shoes' observer updated after each whole-body QP from its contact sites' places
+    and forces (a :class:`~ridempc.mpc.stages.base.TickObserver` of ``wbc_observers``)."""
+
+    def __init__(self, observer: ShoeObserver) -> None:
+        self.observer = observer
+
+    def observe(self, tick: ControlTick) -> None:
+        out = tick.wbc
+        assert out is not None  # after the whole-body QP
+        self.observer.update(tick.estimate, out.site_positions, out.site_forces)

@@ -5,10 +5,11 @@ After each tick's whole-body QP the rider gathers a :class:`HandoverCheck` and a
 backup law (:mod:`~ridempc.mpc.handover`):
 
 1. :func:`plan_failed`: the MPC's QP failed (its previous plan shifted by one step is used);
-2. :func:`dropped`: every foot's load gone at once, a step down (:mod:`~ridempc.mpc.drop`);
+2. :class:`DropWatch`: every foot's load gone at once, a step down (:mod:`~ridempc.mpc.drop`;
+   with the ``drop`` stage);
 3. :func:`needs_slack`: the whole-body QP took slack on its soft rows (:mod:`ridempc.wbc.elastic`);
-4. :func:`pushed`: a push from outside beyond the pair's impulse band
-   (:class:`PushWatch`, :mod:`~ridempc.mpc.impulse`);
+4. :class:`PushWatch`: a push from outside beyond the pair's impulse band
+   (:mod:`~ridempc.mpc.impulse`; with the ``impulse`` stage);
 5. :func:`deviated`: the state beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of
    its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`);
 6. :func:`diverging`: or heading there within a divergence time, until the MPC has held
@@ -20,41 +21,35 @@ from __future__ import annotations
 from typing import NamedTuple, Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
-from ridempc.estimation import EstimatedState
 from ridempc.mpc.divergence import DivergentDeviation
+from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
+from ridempc.mpc.stages.base import ControlTick
 
 __all__ = [
-    "HANDOVER_TRIGGERS",
+    "DropWatch",
     "HandoverCheck",
     "HandoverTrigger",
     "PushWatch",
     "deviated",
     "diverging",
-    "dropped",
+    "handover_triggers",
     "needs_slack",
     "plan_failed",
-    "pushed",
 ]
-
-Array = NDArray[np.float64]
 
 
 class HandoverCheck(NamedTuple):
-    """What the triggers read after a tick's whole-body QP: the plan in force, whether the
-    feet's loads dropped, the QP's slack, why a push is beyond the MPC (or None), the
-    state's deviation from its reference [-], whether a re-push's stroke defers it, whether
-    the MPC has proven itself since the start or its return, and the deviation's
-    divergence."""
+    """What the triggers read after a tick's whole-body QP: the plan in force, the QP's
+    slack, the state's deviation from its reference [-], whether a re-push's stroke defers
+    it, whether the MPC has proven itself since the start or its return, and the
+    deviation's divergence."""
 
     plan: Plan
-    dropping: bool
     slack: float
-    pushed: str | None
     deviation: float
     stroke: bool
     proven: bool
@@ -72,20 +67,10 @@ def plan_failed(check: HandoverCheck) -> str | None:
     return f"MPC plan failed (status {check.plan.status})" if check.plan.fallback else None
 
 
-def dropped(check: HandoverCheck) -> str | None:
-    """The platforms fell away under every foot at once."""
-    return "every foot's load gone at once (a drop)" if check.dropping else None
-
-
 def needs_slack(check: HandoverCheck) -> str | None:
     """The whole-body QP had no solution as posed."""
     slack = check.slack
     return f"whole-body QP infeasible (slack {slack:.3g})" if slack > 0.0 else None
-
-
-def pushed(check: HandoverCheck) -> str | None:
-    """A push beyond what the MPC rides."""
-    return check.pushed
 
 
 def deviated(check: HandoverCheck) -> str | None:
@@ -107,21 +92,29 @@ def diverging(check: HandoverCheck) -> str | None:
     return None
 
 
-# in the order asked: the first reason is the one recorded
-HANDOVER_TRIGGERS: tuple[HandoverTrigger, ...] = (
-    plan_failed,
-    dropped,
-    needs_slack,
-    pushed,
-    deviated,
-    diverging,
-)
+class DropWatch:
+    """The platforms falling away under every foot at once (a step down), from each tick's
+    loads (:class:`~ridempc.mpc.drop.DropDetector`): a tick observer and a trigger."""
+
+    def __init__(self, detector: DropDetector) -> None:
+        self.detector, self.dropping = detector, False
+
+    def reset(self) -> None:
+        """Start over (a new ride)."""
+        self.detector.reset()
+
+    def observe(self, tick: ControlTick) -> None:
+        self.dropping = self.detector.update(tick.loads)
+
+    def __call__(self, check: HandoverCheck) -> str | None:
+        return "every foot's load gone at once (a drop)" if self.dropping else None
 
 
 class PushWatch:
-    """The push from outside, read every tick from the whole-body QP's centre-of-mass
-    velocity and contact forces (:class:`~ridempc.mpc.impulse.ImpulseObserver`); the
-    observer's window restarts while the backup rides (its forces are not the QP's).
+    """The push from outside, read after each whole-body QP from its centre-of-mass
+    velocity and contact forces (:class:`~ridempc.mpc.impulse.ImpulseObserver`): a tick
+    observer (of ``wbc_observers``) and a trigger; the observer's window restarts while the
+    backup rides (its forces are not the QP's).
 
     Args:
         observer: The impulse observer.
@@ -130,21 +123,30 @@ class PushWatch:
 
     def __init__(self, observer: ImpulseObserver, trigger: ImpulseTrigger) -> None:
         self.observer, self._trigger = observer, trigger
+        self.reason: str | None = None
 
-    def __call__(
-        self,
-        estimate: EstimatedState,
-        now: float,
-        on_backup: bool,
-        com_velocity: Array,
-        contact_force: Array,
-        diagnostics: dict[str, float],
-    ) -> str | None:
-        """Why the push is beyond what the MPC rides, or None."""
-        if on_backup:
+    def observe(self, tick: ControlTick) -> None:
+        if tick.on_backup:
             self.observer.reset()
-            return None
-        impulse = self.observer.update(now, com_velocity, contact_force)
-        diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
+            self.reason = None
+            return
+        out = tick.wbc
+        assert out is not None  # after the whole-body QP
+        impulse = self.observer.update(tick.sensors.time, out.com_velocity, out.forces.sum(axis=0))
+        tick.diagnostics["impulse"] = float(np.hypot(impulse[0], impulse[1]))
+        estimate = tick.estimate
         heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
-        return self._trigger(impulse, heading)
+        self.reason = self._trigger(impulse, heading)
+
+    def __call__(self, check: HandoverCheck) -> str | None:
+        """Why the push is beyond what the MPC rides, or None."""
+        return self.reason
+
+
+def handover_triggers(
+    drop: DropWatch | None, push: PushWatch | None
+) -> tuple[HandoverTrigger, ...]:
+    """The triggers in the order asked (the first reason is the one recorded), with the
+    pair's watches where it has them."""
+    triggers = (plan_failed, drop, needs_slack, push, deviated, diverging)
+    return tuple(trigger for trigger in triggers if trigger is not None)
