@@ -388,8 +388,8 @@ def test_push_off_1_0_seed_5_rides_its_roll_wave_within_the_stance_limit(dog) ->
     result = Simulation(scene, rider, scenario, seed=5).run()
     assert result.status == "ok", result.fall_reason
     assert not result.fell and rider.summary().get("safe_hold") is None
-    assert rider.stance is not None and rider.stance.last is not None
-    low, high = rider.stance.last
+    assert rider.stance_roll is not None and rider.stance_roll.limit.last is not None
+    low, high = rider.stance_roll.limit.last
     assert low < -0.1 and high > 0.1  # a normal stance holds the whole wave
     metrics = run_metrics(result, scenario, dog)
     assert metrics["roll_rmse"] < 0.02
@@ -558,10 +558,10 @@ def test_headings_are_unwrapped_to_the_turn_so_far(dog) -> None:
     headings = [i for n, i in names.items() if n.endswith(("_yaw", "_psi"))]
     assert headings
     reference = rider.mpc.reference.states_at(np.array([0.0]))[0]
-    rider._turned = 3.0  # [rad] turned so far
+    rider.turn.turned = 3.0  # [rad] turned so far
     x0 = rider.map.state(estimate)
     x0[headings] = reference[headings] + 3.1 - 2.0 * np.pi  # as the estimate wraps it
-    out = rider._unwrapped(x0, reference)
+    out = rider.turn.unwrapped(x0, reference, rider.layout.headings)
     np.testing.assert_allclose(out[headings], reference[headings] + 3.1, atol=1e-12)
     others = [i for i in range(len(x0)) if i not in headings]
     np.testing.assert_array_equal(out[others], x0[others])

@@ -23,6 +23,7 @@ from ridempc.mpc.stages.deck_roll import side_feet, to_deck
 from ridempc.mpc.stages.manoeuvre_shapers import RepushBlend
 from ridempc.mpc.stages.support import foot_support
 from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, handover_triggers
+from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
@@ -121,3 +122,14 @@ def test_a_new_manoeuvre_ends_a_running_blend() -> None:
     running = BuildInputs(**{**base, "began": False, "switched": False})
     assert blend.running(running)
     assert not blend.running(running._replace(began=True))
+
+
+def test_the_turn_so_far_integrates_each_rate_until_the_next() -> None:
+    turn = TurnSoFar()
+    assert turn.advance(1.0, 0.5) == 0.0  # nothing before the first rate
+    assert turn.advance(3.0, -1.0) == pytest.approx(1.0)  # 0.5 rad/s over 2 s
+    assert turn.advance(3.5, 0.0) == pytest.approx(0.5)
+    # the estimate's heading wraps at pi, the commanded turn does not: 2 pi is added back
+    x0, reference = np.array([3.1 - 2.0 * math.pi, 0.3]), np.array([0.0, 0.0])
+    turn.turned = 3.0
+    np.testing.assert_allclose(turn.unwrapped(x0, reference, [0]), [3.1, 0.3])

@@ -2,17 +2,17 @@
 
 The rider is a loop over stages, each of one protocol (:mod:`ridempc.mpc.stages.base`),
 built once from the pair file's ``[stages.*]`` (``pairs/<robot>-<board>.toml``) and listed,
-in the order they act, in :meth:`MpcRider.__init__` (``drifts``, ``shapers``, ``triggers``).
-Every 2 ms (500 Hz) the rider
+in the order they act, in one place, :meth:`MpcRider._build_stages` (``observers``,
+``wbc_observers``, ``drifts``, ``shapers``, ``triggers``). Every 2 ms (500 Hz) the rider
 
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
    board from its own feet), each shoe's heading from its direction of travel
-   (:mod:`~ridempc.mpc.shoe_heading`), and reads the stance's loads for the payload
-   (:mod:`~ridempc.mpc.stages.payload_models`) and the platforms falling away
-   (:mod:`~ridempc.mpc.drop`);
+   (:mod:`~ridempc.mpc.shoe_heading`), and updates the **tick observers** (the platforms
+   falling away, :class:`~ridempc.mpc.stages.triggers.DropWatch`; the stance's loads for the
+   payload, :mod:`~ridempc.mpc.stages.payload_models`);
 2. every 15th tick (30 Hz), chooses the manoeuvre the command asks for
-   (:mod:`~ridempc.mpc.manoeuvre`: a push-off or a speed change follows its library
-   trajectory, then rides on; on the skateboard it coasts and pushes again), reads the
+   (:mod:`~ridempc.mpc.stages.manoeuvre_choice`: a push-off or a speed change follows its
+   library trajectory, then rides on; on the skateboard it coasts and pushes again), reads the
    commands over the horizon (the command source,
    :class:`~ridempc.mpc.stages.commands.CommandHorizon`; on the skateboard a yaw rate
    steered by the deck's roll, within what the stance holds,
@@ -36,8 +36,9 @@ Every 2 ms (500 Hz) the rider
    :mod:`~ridempc.mpc.stages.feet_targets`; each shoe's drag as its platform's
    acceleration) and solves the 500 Hz whole-body QP
    (:class:`~ridempc.wbc.WholeBodyController`, :mod:`ridempc.mpc.rider_wbc`);
-4. asks the **handover triggers** in order (:mod:`~ridempc.mpc.stages.triggers`) why the
-   MPC cannot ride, and sends the QP's torques as feedforward, each led over its motor's
+4. updates the observers of the QP's output (the shoes' observer, the push's watch), asks
+   the **handover triggers** in order (:mod:`~ridempc.mpc.stages.triggers`) why the MPC
+   cannot ride, and sends the QP's torques as feedforward, each led over its motor's
    torque delay (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD
    (:func:`~ridempc.mpc.rider_wbc.tracking_gains`).
 
@@ -53,9 +54,9 @@ the MPC takes over once ready (:mod:`~ridempc.mpc.readiness`; ``summary()``'s
 ``mpc_takeover_s``). Only where the backup too has no finite command are the joints held
 where they are (``safe_hold``).
 
-**Towards a few hundred lines.** What is left here beyond the loop: the manoeuvre's choice
-and the library frame's turn in :meth:`MpcRider._mpc_tick` (a *command source* stage of its
-own), the solve's dispatch to the tick, thread or process (:meth:`MpcRider._submit`,
+**Towards a few hundred lines.** What is left here beyond the loop: the commanded roll's
+and turn's composition and the library frame's turn in :meth:`MpcRider._mpc_tick` (the
+command source's), the solve's dispatch to the tick, thread or process (:meth:`MpcRider._submit`,
 :meth:`MpcRider._build_and_run`: a solver stage beside :mod:`~ridempc.mpc.solver_process`),
 the handover's bookkeeping at a plan's take-up (:meth:`MpcRider._adopt`: divergence,
 probation, readiness, the backup's standby; an *observer* of the plans) and the wiring of
@@ -68,14 +69,13 @@ import copy
 import math
 import time
 from concurrent.futures import Future
-from dataclasses import replace
 from functools import cache, partial
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.boards.canonical import BoardState, board_state_columns
+from ridempc.boards.canonical import board_state_columns
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
@@ -110,28 +110,35 @@ from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_handover import deviation_deferred
-from ridempc.mpc.push_side import PushSide, first_stride
+from ridempc.mpc.push_side import PushSide
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
-from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
-from ridempc.mpc.stages.base import ControlTick, DriftSource, MpcTick, ProblemShaper, TickObserver
+from ridempc.mpc.stages.base import (
+    ControlTick,
+    DriftSource,
+    MpcTick,
+    ProblemShaper,
+    TickObserver,
+    present,
+)
 from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper, ShoeLines
 from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
 from ridempc.mpc.stages.commands import CommandHorizon
-from ridempc.mpc.stages.deck_roll import DeckSides, RollDrift, StanceRoll, side_feet
+from ridempc.mpc.stages.deck_roll import deck_stages
 from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observer
 from ridempc.mpc.stages.feet_targets import FeetTargets
+from ridempc.mpc.stages.manoeuvre_choice import ManoeuvreChoice
 from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
 from ridempc.mpc.stages.payload_models import PayloadModels
 from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_columns, shoe_observer
 from ridempc.mpc.stages.support import contacts_to_feet, foot_support
 from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, PushWatch, handover_triggers
+from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.mpc.stagger import standby_phase
-from ridempc.mpc.stance import StanceLimit
 from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
@@ -140,7 +147,6 @@ from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.trajopt.schedule import Contact
-from ridempc.trajopt.skateboard import skateboard_model
 from ridempc.wbc import WbcTargets, to_motor_command
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.targets import WbcOutput
@@ -323,34 +329,20 @@ class MpcRider(Controller):
         )
         self._guidance = stages.guidance is not None  # shoe headings turned onto their lines
         self._shoe_columns = shoe_columns(columns) if self.shoes is not None else ()
-        rolls = stages.roll_steering is not None or stages.roll_observer is not None
-        deck = skateboard_model(loaded).reduced if loaded is not None and rolls else None
-        steers = deck if stages.roll_steering is not None else None
+        n_feet = len(robot.params.foot_bodies)  # the deck's roll steering and balance
+        deck = deck_stages(self.pair, loaded, columns, self.mpc, n_feet, self.map.com)
         self.commands = CommandHorizon(  # the commands read over the horizon
             self,
             self.mpc.settings,
             self.pair.roll_lead,
             self.steers,
-            steers.steer_gain if steers is not None else None,
+            deck.steer_gain,
             self.pair.speed_preview,
         )
-        gain = self.pair.roll_observer
-        roll, roll_rate = BoardState(0, "roll"), BoardState(0, "roll_rate")  # the deck's
-        self.roll_observer = (
-            RollObserver(columns[roll], columns[roll_rate], deck, gain)
-            if deck is not None and gain is not None and roll_rate in columns
-            else None
+        self.choice = ManoeuvreChoice(  # the manoeuvre the command asks for
+            self.selector, self.mpc, self.layout, self.pair, self.push_side, self.commands
         )
-        self.stance = (
-            StanceLimit(self.pair.stance_roll)
-            if self.roll_observer is not None and self.pair.stance_roll is not None
-            else None
-        )
-        sides = DeckSides(self.mpc, self.pair.weight, side_feet(len(robot.params.foot_bodies)))
-        self._deck_sides = sides
-        self.stance_roll = (
-            StanceRoll(self.stance, sides, self.map.com) if self.stance is not None else None
-        )
+        self.roll_drift, self.stance_roll = deck.drift, deck.stance
         self.feet = ReferenceFeet(
             self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
         )
@@ -362,9 +354,7 @@ class MpcRider(Controller):
         self._plan_frame = PlanarFrame()
         self._last_problem: MpcProblem | None = None
         self._plan_time = 0.0
-        self._turned = 0.0  # [rad] the commanded yaw rate integrated over the ride
-        self._turn_time: float | None = None
-        self._turn_rate = 0.0
+        self.turn = TurnSoFar()  # the commanded yaw rate integrated over the ride
         self._hold: MotorCommand | None = None
         self._wbc_failures = 0  # in all
         self._hold_reason: str | None = None
@@ -419,30 +409,28 @@ class MpcRider(Controller):
             if self.payload is not None
             else None
         )
-        # the stages, each list in the order its stages act (ridempc/mpc/stages/base.py)
+        self._build_stages()
+
+    def _build_stages(self) -> None:
+        """Every list of stages, each in the order its stages act (one protocol a list,
+        :mod:`ridempc.mpc.stages.base`): where a new stage is added."""
+        shoes = ShoeUpdate(self.shoes) if self.shoes is not None else None
+        self.observers: tuple[TickObserver, ...] = present(self.drop_watch, self.payload_models)
+        self.wbc_observers: tuple[TickObserver, ...] = present(shoes, self.push_watch)
         self.drifts: tuple[DriftSource, ...] = self._drift_sources()
         self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
-        self.observers: tuple[TickObserver, ...] = tuple(
-            observer for observer in (self.drop_watch, self.payload_models) if observer is not None
-        )
-        shoes = ShoeUpdate(self.shoes) if self.shoes is not None else None
-        self.wbc_observers: tuple[TickObserver, ...] = tuple(
-            observer for observer in (shoes, self.push_watch) if observer is not None
-        )
         self.triggers = handover_triggers(self.drop_watch, self.push_watch)
 
     def _drift_sources(self) -> tuple[DriftSource, ...]:
         """The disturbance observers whose drifts the MPC's rates carry, in the order they
         are summed: the deck's torque, the payload, the steady disturbance, the lean's."""
         dt, names = self.mpc.settings.dt, self.layout.names
-        observer, sides = self.roll_observer, self._deck_sides
-        sources: tuple[DriftSource | None, ...] = (
-            RollDrift(observer, sides, dt) if observer is not None else None,
+        return present(
+            self.roll_drift,
             self.payload_models,
             SteadyDrift(self.disturbance, dt) if self.disturbance is not None else None,
             LeanDrift(self.lean, names["vy"]) if self.lean is not None else None,
         )
-        return tuple(source for source in sources if source is not None)
 
     def _problem_shapers(self) -> tuple[ProblemShaper, ...]:
         """The problem shapers, in the order they act: the manoeuvre's (coasting, the
@@ -450,7 +438,7 @@ class MpcRider(Controller):
         lean, the shoes' lines and drags, the swing's held forces)."""
         mpc, layout, step = self.mpc, self.layout, self.pair.swing_force_step
         blend = RepushBlend(mpc, layout)
-        shapers: tuple[ProblemShaper | None, ...] = (
+        return present(
             Coasting(layout, blend),
             RollCommand(mpc, layout),
             blend,
@@ -460,7 +448,6 @@ class MpcRider(Controller):
             ShoeLines(self._shoe_columns, self._guidance) if self.shoes is not None else None,
             HeldForces(mpc, step) if step is not None else None,
         )
-        return tuple(shaper for shaper in shapers if shaper is not None)
 
     def _mapped(self, estimate: EstimatedState) -> EstimatedState:
         """The estimate as the MPC sees it: each Hovershoe's origin on its axis."""
@@ -586,48 +573,23 @@ class MpcRider(Controller):
         speed = self._speed(estimate)
         feet = np.asarray(estimate.foot_position, dtype=float)
         self._com_height = float(self.map.com(estimate)[2] - feet[:, 2].mean())
-        # The manoeuvre is chosen, and its phase matched, on the CoM's speed, which the
-        # reference's ``vx`` is: read off the feet, a Segway's speed swung +-0.3 m/s about
-        # the rider's at 3-4 m/s, and one swing started the 4 m/s push 0.36 m/s ahead of
-        # the rider (velocity-steps fell at 19.9 s).
-        rider_speed = self.map.rider_speed(estimate)
-        wanted = self.selector.select(
-            self.commands.speed_command(command, now), self.manoeuvre, now, rider_speed
-        )
-        if wanted is self.manoeuvre and self._coasting(self.manoeuvre.reference_time(now)):
-            wanted = self.selector.repush(command, wanted, now, speed)  # slowed: push again
-        began = wanted is not self.manoeuvre
-        if began:
+        rider_speed = self.map.rider_speed(estimate)  # the CoM's, as the reference's vx
+        coasted = self._coasting(self.manoeuvre.reference_time(now))
+        chosen = self.choice(self.manoeuvre, command, now, speed, rider_speed, coasted)
+        began = chosen is not None
+        if chosen is not None:
             self._divergence.reset()  # a new reference: its deviation steps, no divergence
-        if began:
-            self.mpc.retarget(wanted.library_kind, wanted.target)
-            if wanted.kind == REPUSH and self.push_side is not None:
-                self.mpc.reference = self.push_side.reference(
-                    self.mpc.reference,
-                    self.commands.yaw_rate_ahead(command, now, first_stride(self.mpc.reference)),
-                    self.pair.board_states,
-                )
-            reference = self.mpc.reference
-            start = self.selector.phase_start(
-                reference.times,
-                reference.states[:, self.layout.names["vx"]],
-                rider_speed,
-                now,
-                wanted.kind,
-                self.pair.start_speed,
-            )
-            self.manoeuvre = replace(wanted, start=start)
-            switched = wanted.kind == REPUSH  # from wherever the coast left the rider
+            self.manoeuvre = chosen
+            switched = chosen.kind == REPUSH  # from wherever the coast left the rider
             # any switch starts mid-turn: the reference's heading already carries the turn
             # made (anchored at the library's, a rider 0.2 rad into yaw-steps was asked to
             # turn back at once and fell in the push; one 0.67 rad into a course, in a stop)
-            self._anchor(estimate, now, self._turned)
+            self._anchor(estimate, now, self.turn.turned)
         else:
             switched = False
             if self.handover.starting and self.manoeuvre.kind == HOLD:  # the frame on the
-                self._anchor(estimate, now, self._turned)  # board while the backup holds it
+                self._anchor(estimate, now, self.turn.turned)  # board while the backup holds it
         t_ref = self.manoeuvre.reference_time(now)
-        roll = self.commands.roll_horizon(command, now)
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
@@ -646,12 +608,10 @@ class MpcRider(Controller):
         if self.payload_models is not None:
             self.payload_models.absorb(tick)
         pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
-        if balancing or (self.manoeuvre.kind == REPUSH and not pushing):
-            roll = roll + self.commands.steering_roll(command, now, speed)
-        if self.stance_roll is not None:
-            roll = self.stance_roll(roll, tick)
-        turn = self.commands.yaw_rate_horizon(command, now)
-        turn = turn + self.commands.roll_turn(roll, speed, self.layout.names)
+        steering = balancing or (self.manoeuvre.kind == REPUSH and not pushing)
+        limit = partial(self.stance_roll, tick=tick) if self.stance_roll is not None else None
+        names = self.layout.names
+        roll, turn = self.commands.roll_and_turn(command, now, speed, steering, limit, names)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
         if self.shoes is not None:  # the frame follows platform 0 onto its spread line
             here = spread_lines(here[None, :], self._shoe_columns, command.lateral_offset)[0]
@@ -660,7 +620,7 @@ class MpcRider(Controller):
             self.lean.update(now, command.yaw_rate, yaw_rate, speed)
         carried = self.lean.turn_rate if self.lean is not None else 0.0
         self._follow_board(mapped, here, turn, now, coasting, carried)
-        x0 = self._unwrapped(self.map.state(mapped), here)
+        x0 = self.turn.unwrapped(self.map.state(mapped), here, self.layout.headings)
         started = time.perf_counter()
         turned = math.remainder(self.map.frame.yaw - self._plan_frame.yaw, 2.0 * math.pi)
         tick = tick._replace(frame_turn=turned)  # the frame has moved onto the board
@@ -680,7 +640,7 @@ class MpcRider(Controller):
             speed,
             roll,
             turn,
-            self._turned,
+            self.turn.turned,
             coasting,
             switched,
             copy.copy(self.lean),
@@ -814,16 +774,6 @@ class MpcRider(Controller):
             mpc_iterations=float(plan.iterations),
         )
 
-    def _unwrapped(self, x0: Array, reference: Array) -> Array:
-        """``x0`` with each heading (the base's yaw, the platforms') [rad] within
-        :math:`\\pi` of the ``reference`` state's turned by the turn so far: the estimate's
-        angles wrap at :math:`\\pm\\pi`, the commanded turn does not."""
-        out = x0.copy()
-        for i in self.layout.headings:
-            target = reference[i] + self._turned
-            out[i] = target + math.remainder(x0[i] - target, 2.0 * math.pi)
-        return out
-
     def _coasting(self, t_ref: float) -> bool:
         """Whether the rider coasts (:meth:`ManoeuvreSelector.coasting`): past the end of
         an ``accelerate`` on a board it drives only by pushing off."""
@@ -848,14 +798,12 @@ class MpcRider(Controller):
         and all along it while turning or coasting (the reference's steady ride is not
         where a coasting board goes); on a board whose heading the frame follows, that
         heading carried by ``yaw_rate`` [rad/s], the turn the rider is making."""
-        if self._turn_time is not None:
-            self._turned += self._turn_rate * (now - self._turn_time)
-        self._turn_time, self._turn_rate = now, float(turn[0])
+        turned = self.turn.advance(now, float(turn[0]))
         x, y, heading = self.layout.board_pose(reference)
-        along = coasting or bool(np.any(turn)) or self._turned != 0.0
+        along = coasting or bool(np.any(turn)) or turned != 0.0
         self.map.follow_sideways(
             estimate,
-            (x, y, heading + self._turned),
+            (x, y, heading + turned),
             along=along,
             heading=self._follows_heading,
             yaw_rate=yaw_rate,

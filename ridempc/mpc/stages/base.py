@@ -1,7 +1,7 @@
 """The protocols of the rider's stages (:class:`~ridempc.mpc.rider.MpcRider`'s loop).
 
 Each per-pair mechanism the pair file names under ``[stages.*]`` is a stage of one of these
-kinds, and the rider lists and orders them in one place (its ``__init__``):
+kinds, and the rider lists and orders them in one place (``MpcRider._build_stages``):
 
 - :class:`TickObserver`: updated every control tick (500 Hz) from the sensors, the estimate
   and the feet's loads (``observers``: the drop's watch, the payload's loads), or, in
@@ -15,19 +15,24 @@ kinds, and the rider lists and orders them in one place (its ``__init__``):
   commanded roll, a re-push's blend, the turn, the crouch and the lean, the shoes' lines,
   the swing's held forces), applied in order where the problem is built (the loop's tick,
   the solver thread or the solver process, whose copy keeps a stateful shaper's state);
-- the command source (:class:`~ridempc.mpc.stages.commands.CommandHorizon`): the commands
-  read over the horizon;
+- the command sources: the manoeuvre the command asks for
+  (:class:`~ridempc.mpc.stages.manoeuvre_choice.ManoeuvreChoice`) and the commands read
+  over the horizon (:class:`~ridempc.mpc.stages.commands.CommandHorizon`), the deck's roll
+  held to the stance (:class:`~ridempc.mpc.stages.deck_roll.StanceRoll`);
 - :class:`~ridempc.mpc.stages.triggers.HandoverTrigger` (``triggers``): why the MPC
   cannot ride this tick (:mod:`~ridempc.mpc.stages.triggers`), asked in order; a watch
   that observes every tick may be a trigger too.
 
-To add a stage: write its module (one concept), a class meeting the protocol, and add it to
-the rider's list of that protocol where the others are built, in the order it acts.
+To add a stage: write its module (one concept, its physics in the docstring), a class
+meeting the protocol, build it in ``MpcRider.__init__`` from the pair file's stage (None when
+the pair does not name it) and add it to its protocol's list in ``_build_stages`` (or
+``_drift_sources``, ``_problem_shapers``, :func:`~ridempc.mpc.stages.triggers.handover_triggers`)
+in the order it acts.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple, Protocol
+from typing import TYPE_CHECKING, NamedTuple, Protocol, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -40,9 +45,15 @@ if TYPE_CHECKING:
     from ridempc.sim.sensors import SensorPacket
     from ridempc.wbc.targets import WbcOutput
 
-__all__ = ["ControlTick", "DriftSource", "MpcTick", "ProblemShaper", "TickObserver"]
+__all__ = ["ControlTick", "DriftSource", "MpcTick", "ProblemShaper", "TickObserver", "present"]
 
 Array = NDArray[np.float64]
+Stage = TypeVar("Stage")
+
+
+def present(*stages: Stage | None) -> tuple[Stage, ...]:
+    """The stages the pair has (None: a stage it does not use), in the order given."""
+    return tuple(stage for stage in stages if stage is not None)
 
 
 class ControlTick(NamedTuple):

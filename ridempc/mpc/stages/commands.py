@@ -11,6 +11,7 @@ the roll that steers it and a roll the turn it steers (eq. 14,
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -107,6 +108,28 @@ class CommandHorizon:
         if self.steer_gain is None or not ManoeuvreSelector.commands_roll(names, roll):
             return np.zeros(steps)
         return np.asarray(yaw_rate(speed, roll[:steps], self.steer_gain), dtype=float)
+
+    def roll_and_turn(
+        self,
+        command: Command,
+        now: float,
+        speed: float,
+        steering: bool,
+        limit: Callable[[Array], Array] | None,
+        names: dict[str, int],
+    ) -> tuple[Array, Array]:
+        """The commanded deck roll at the horizon's nodes [rad] and the turn over its steps
+        [rad/s]: the roll commanded, plus, while ``steering`` (balancing, or a re-push with
+        no foot on the ground), the roll that steers the commanded yaw rate, held within
+        ``limit`` (the stance's, or None); the turn commanded plus the one the roll steers
+        at the board's ``speed`` [m/s] (``names``: the MPC's state columns)."""
+        roll = self.roll_horizon(command, now)
+        if steering:
+            roll = roll + self.steering_roll(command, now, speed)
+        if limit is not None:
+            roll = limit(roll)
+        turn = self.yaw_rate_horizon(command, now) + self.roll_turn(roll, speed, names)
+        return roll, turn
 
     def yaw_rate_horizon(self, command: Command, now: float) -> Array:
         """The commanded yaw rate over the horizon's steps [rad/s], read ahead from the

@@ -17,18 +17,31 @@ Both restart when the rider stops balancing (a push-off changes the stance).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.boards.board import Board
+from ridempc.boards.canonical import BoardState
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.controller import LinearMpc
+from ridempc.mpc.pairs import MpcPair
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.stages.base import MpcTick
 from ridempc.mpc.stance import StanceLimit
+from ridempc.trajopt.skateboard import skateboard_model
 
-__all__ = ["DeckSides", "RollDrift", "StanceRoll", "side_feet", "to_deck"]
+__all__ = [
+    "DeckSides",
+    "DeckStages",
+    "RollDrift",
+    "StanceRoll",
+    "deck_stages",
+    "side_feet",
+    "to_deck",
+]
 
 Array = NDArray[np.float64]
 
@@ -142,3 +155,48 @@ class StanceRoll:
         low, high = limit.bounds(places, offset, float(board.roll), dt, far_share)
         tick.diagnostics.update(stance_low=low, stance_high=high)
         return np.clip(roll, low, high)
+
+
+class DeckStages(NamedTuple):
+    """A pair's deck-roll stages: the deck's steering gain :math:`K_{board}` [1/m] where it
+    steers by its roll (the ``roll_steering`` stage), the deck's torque as a drift (the
+    ``roll_observer`` stage) and the stance's hold on the commanded roll (the ``stance``
+    stage, with the observer); None where the pair has not the stage."""
+
+    steer_gain: float | None
+    drift: RollDrift | None
+    stance: StanceRoll | None
+
+
+def deck_stages(
+    pair: MpcPair,
+    board: Board | None,
+    columns: Mapping[BoardState, int],
+    mpc: LinearMpc,
+    n_feet: int,
+    com: Callable[[EstimatedState], Array],
+) -> DeckStages:
+    """The deck-roll stages the pair file names, for ``board`` (its description, or None),
+    the MPC's board state ``columns``, its ``n_feet`` feet and the estimate's ``com``."""
+    stages = pair.description.stages
+    rolls = stages.roll_steering is not None or stages.roll_observer is not None
+    deck = skateboard_model(board).reduced if board is not None and rolls else None
+    steers = deck if stages.roll_steering is not None else None
+    gain = pair.roll_observer
+    roll, roll_rate = BoardState(0, "roll"), BoardState(0, "roll_rate")  # the deck's
+    observer = (
+        RollObserver(columns[roll], columns[roll_rate], deck, gain)
+        if deck is not None and gain is not None and roll_rate in columns
+        else None
+    )
+    sides = DeckSides(mpc, pair.weight, side_feet(n_feet))
+    limit = (
+        StanceLimit(pair.stance_roll)
+        if observer is not None and pair.stance_roll is not None
+        else None
+    )
+    return DeckStages(
+        steers.steer_gain if steers is not None else None,
+        RollDrift(observer, sides, mpc.settings.dt) if observer is not None else None,
+        StanceRoll(limit, sides, com) if limit is not None else None,
+    )

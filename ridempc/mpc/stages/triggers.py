@@ -27,7 +27,7 @@ from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
-from ridempc.mpc.stages.base import ControlTick
+from ridempc.mpc.stages.base import ControlTick, present
 
 __all__ = [
     "DropWatch",
@@ -148,5 +148,4 @@ def handover_triggers(
 ) -> tuple[HandoverTrigger, ...]:
     """The triggers in the order asked (the first reason is the one recorded), with the
     pair's watches where it has them."""
-    triggers = (plan_failed, drop, needs_slack, push, deviated, diverging)
-    return tuple(trigger for trigger in triggers if trigger is not None)
+    return present(plan_failed, drop, needs_slack, push, deviated, diverging)
