@@ -22,7 +22,13 @@ from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.mpc.stages.deck_roll import side_feet, to_deck
 from ridempc.mpc.stages.manoeuvre_shapers import RepushBlend
 from ridempc.mpc.stages.support import foot_support
-from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, handover_triggers
+from ridempc.mpc.stages.triggers import (
+    DropWatch,
+    HandoverCheck,
+    diverging,
+    handover_triggers,
+    plan_failed,
+)
 from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
@@ -133,3 +139,37 @@ def test_the_turn_so_far_integrates_each_rate_until_the_next() -> None:
     x0, reference = np.array([3.1 - 2.0 * math.pi, 0.3]), np.array([0.0, 0.0])
     turn.turned = 3.0
     np.testing.assert_allclose(turn.unwrapped(x0, reference, [0]), [3.1, 0.3])
+
+
+@pytest.mark.parametrize(
+    ("robot", "board"),
+    [("cassie", "hovershoes"), ("cassie", "segway"), ("cyberdog2", "skateboard")],
+)
+def test_each_pair_file_stage_is_in_its_protocol_list(robot: str, board: str) -> None:
+    """The rider builds a stage where its pair file names one, and none elsewhere."""
+    from ridempc.mpc.rider import MpcRider
+    from ridempc.robots import load_robot
+
+    rider = MpcRider(load_robot(robot), board)
+    stages = rider.pair.description.stages
+    kinds = {type(stage).__name__ for stage in (*rider.drifts, *rider.shapers)}
+    kinds |= {type(stage).__name__ for stage in (*rider.observers, *rider.wbc_observers)}
+    named = {
+        "RollDrift": stages.roll_observer,
+        "SteadyDrift": stages.disturbance,
+        "PayloadModels": stages.payload,
+        "DropWatch": stages.drop,
+        "PushWatch": stages.impulse,
+        "ShoeUpdate": stages.shoe_observer,
+    }
+    for kind, stage in named.items():
+        assert (kind in kinds) == (stage is not None), kind
+    assert (rider.stance_roll is not None) == (stages.stance is not None)
+    assert rider.triggers[0] is plan_failed and rider.triggers[-1] is diverging
+    assert [type(s).__name__ for s in rider.shapers[:4]] == [
+        "Coasting",
+        "RollCommand",
+        "RepushBlend",
+        "Turn",
+    ]
+    rider.close()
