@@ -93,7 +93,6 @@ from ridempc.mpc.handover import (
     deviation,
     share_estimator,
 )
-from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
     HOLD,
@@ -114,7 +113,6 @@ from ridempc.mpc.push_side import PushSide
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
-from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
 from ridempc.mpc.stages.base import (
@@ -125,7 +123,7 @@ from ridempc.mpc.stages.base import (
     TickObserver,
     present,
 )
-from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper, ShoeLines
+from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper
 from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
 from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.mpc.stages.deck_roll import deck_stages
@@ -134,7 +132,7 @@ from ridempc.mpc.stages.feet_targets import FeetTargets
 from ridempc.mpc.stages.manoeuvre_choice import ManoeuvreChoice
 from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
 from ridempc.mpc.stages.payload_models import PayloadModels
-from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_columns, shoe_observer
+from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_stages
 from ridempc.mpc.stages.support import contacts_to_feet, foot_support
 from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, PushWatch, handover_triggers
 from ridempc.mpc.stages.turn import TurnSoFar
@@ -315,20 +313,9 @@ class MpcRider(Controller):
         # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
         # applies the MPC's centre of pressure along each foot, not an even share.
         self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
-        # where each foot stands along its shoe and each shoe's drag (Hovershoes)
-        self.shoes = (
-            shoe_observer(loaded, self.wbc.model, self.platform_feet)
-            if loaded is not None and stages.shoe_observer is not None
-            else None
-        )
-        # each shoe's heading from its direction of travel: the soles creep round on the pads
-        self.shoe_heading = (
-            ShoeHeading(self.shoes.platforms)
-            if self.shoes is not None and stages.shoe_heading is not None
-            else None
-        )
-        self._guidance = stages.guidance is not None  # shoe headings turned onto their lines
-        self._shoe_columns = shoe_columns(columns) if self.shoes is not None else ()
+        # where each foot stands along its shoe and each shoe's drag, its heading (Hovershoes)
+        shoes = shoe_stages(stages, loaded, self.wbc.model, self.platform_feet, columns)
+        self.shoes, self.shoe_heading, self._shoe_lines, self._shoe_columns = shoes
         n_feet = len(robot.params.foot_bodies)  # the deck's roll steering and balance
         deck = deck_stages(self.pair, loaded, columns, self.mpc, n_feet, self.map.com)
         self.commands = CommandHorizon(  # the commands read over the horizon
@@ -391,14 +378,8 @@ class MpcRider(Controller):
             self.handover.start_on_backup()
         self._diagnostics: dict[str, float] = {}
         # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
-        bands = stages.impulse
-        mass = self.wbc.model.mass  # [kg] the rider's, as modelled
-        self.impulse = ImpulseObserver(mass) if bands is not None else None
-        self.push_watch = (
-            PushWatch(self.impulse, ImpulseTrigger(bands.band, bands.sideways))
-            if self.impulse is not None and bands
-            else None
-        )
+        self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass)
+        self.impulse = self.push_watch.observer if self.push_watch is not None else None
         self.payload_models = (
             PayloadModels(
                 self.payload,
@@ -445,7 +426,7 @@ class MpcRider(Controller):
             Turn(layout),
             CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
             LeanShaper(mpc, layout) if self.lean is not None else None,
-            ShoeLines(self._shoe_columns, self._guidance) if self.shoes is not None else None,
+            self._shoe_lines,
             HeldForces(mpc, step) if step is not None else None,
         )
 

@@ -6,16 +6,26 @@ the shoes' problem shaper (:class:`~ridempc.mpc.stages.board_shapers.ShoeLines`)
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import cast
+from typing import NamedTuple, cast
 
 from ridempc.boards.board import Board
 from ridempc.boards.canonical import BoardState
+from ridempc.mpc.shoe_heading import ShoeHeading
 from ridempc.mpc.shoe_observer import ShoeObserver
 from ridempc.mpc.stages.base import ControlTick
+from ridempc.mpc.stages.board_shapers import ShoeLines
+from ridempc.pair_description import Stages
 from ridempc.trajopt.platforms import HovershoesBoard, wheeled_board
 from ridempc.wbc.model import WholeBodyModel
 
-__all__ = ["SHOE_QUANTITIES", "ShoeUpdate", "shoe_columns", "shoe_observer"]
+__all__ = [
+    "SHOE_QUANTITIES",
+    "ShoeStages",
+    "ShoeUpdate",
+    "shoe_columns",
+    "shoe_observer",
+    "shoe_stages",
+]
 
 # each shoe's quantities that its lines, its foot's place and its drag move, in this order
 SHOE_QUANTITIES: tuple[str, ...] = ("x", "y", "heading", "speed")
@@ -53,3 +63,33 @@ class ShoeUpdate:
         out = tick.wbc
         assert out is not None  # after the whole-body QP
         self.observer.update(tick.estimate, out.site_positions, out.site_forces)
+
+
+class ShoeStages(NamedTuple):
+    """A pair's shoe stages (None, or no columns, without the ``shoe_observer`` stage): the
+    observer, each shoe's heading from its direction of travel (the soles creep round on
+    the pads; the ``shoe_heading`` stage), the lines' problem shaper (each shoe's heading
+    turned onto its line with the ``guidance`` stage) and each shoe's columns."""
+
+    observer: ShoeObserver | None
+    heading: ShoeHeading | None
+    lines: ShoeLines | None
+    columns: tuple[tuple[int, ...], ...]
+
+
+def shoe_stages(
+    stages: Stages,
+    board: Board | None,
+    model: WholeBodyModel,
+    platform_feet: Sequence[Sequence[str]],
+    columns: Mapping[BoardState, int],
+) -> ShoeStages:
+    """The shoe stages the pair file's ``stages`` name, for ``board`` (its description, or
+    None), the whole-body ``model``, the feet per platform and the MPC's board state
+    ``columns``."""
+    if board is None or stages.shoe_observer is None:
+        return ShoeStages(None, None, None, ())
+    observer = shoe_observer(board, model, platform_feet)
+    heading = ShoeHeading(observer.platforms) if stages.shoe_heading is not None else None
+    shoes = shoe_columns(columns)
+    return ShoeStages(observer, heading, ShoeLines(shoes, stages.guidance is not None), shoes)

@@ -28,6 +28,7 @@ from ridempc.mpc.handover import HANDOVER_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.stages.base import ControlTick, present
+from ridempc.pair_description import ImpulseStage
 
 __all__ = [
     "DropWatch",
@@ -124,6 +125,14 @@ class PushWatch:
     def __init__(self, observer: ImpulseObserver, trigger: ImpulseTrigger) -> None:
         self.observer, self._trigger = observer, trigger
         self.reason: str | None = None
+
+    @classmethod
+    def of(cls, stage: ImpulseStage | None, mass: float) -> PushWatch | None:
+        """With the pair's ``impulse`` stage (its bands), the watch of a rider of ``mass``
+        [kg], as modelled; None without it."""
+        if stage is None:
+            return None
+        return cls(ImpulseObserver(mass), ImpulseTrigger(stage.band, stage.sideways))
 
     def observe(self, tick: ControlTick) -> None:
         if tick.on_backup:
