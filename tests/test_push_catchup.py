@@ -89,3 +89,31 @@ def test_the_extra_speed_moves_the_places_by_its_integral() -> None:
     np.testing.assert_allclose(change[:, names["vx"]], (-0.1 + extra) * np.cos(heading))
     steps = np.diff(change[:, names["com_x"]])
     np.testing.assert_allclose(steps, (-0.1 + extra[:-1]) * np.cos(heading[:-1]) * dt, atol=1e-12)
+
+
+def test_a_board_at_its_rolling_start_is_asked_no_more_than_the_entry_plans() -> None:
+    """The lag asked back is at most how far the board is below the entry's rolling start:
+    none at or above it (the strokes are laid for that board), the smaller of the two
+    below it, and it fades out continuously as the board reaches it."""
+    from ridempc.mpc.manoeuvre import StateLayout
+    from ridempc.mpc.pairs import load_mpc_pair
+    from ridempc.mpc.push_catchup import stroke_catch_up
+    from ridempc.mpc.reference import select_reference
+
+    reference = select_reference("cyberdog2", "skateboard", "repush", 0.7)
+    layout = StateLayout.from_pair(reference.state_names, load_mpc_pair("cyberdog2", "skateboard"))
+    n, dt = 12, 0.05
+    ground = [j for j, step in enumerate(reference.schedule) if Contact.GROUND in step]
+    t = float(reference.times[0]) + ground[0] * reference.dt  # the first push's touchdown
+    window = reference.states_at(t + dt * np.arange(n + 1))
+    planned = float(window[0, layout.names["board_v"]])
+    problem = replace(_problem([(B, G)] * n, dt=dt, nx=window.shape[1]), state_reference=window)
+    share = n * dt / ground_time_left(reference, t)
+
+    def asked(speed: float, start: float) -> float:
+        return float(stroke_catch_up(problem, layout, reference, t, speed, start)[-1])
+
+    slow = planned - 0.1  # 0.1 m/s behind the entry
+    assert asked(slow, slow) == 0.0 and asked(slow, slow - 0.05) == 0.0
+    assert asked(slow, slow + 0.05) == pytest.approx(0.05 * share)  # below the start by less
+    assert asked(slow, slow + 0.5) == pytest.approx(0.1 * share)  # the lag, smaller

@@ -19,6 +19,14 @@ on top of the shift: the strokes left in the entry make the lag up by their end,
 between strokes (and after the last) the reference coasts as the entry does. Asked over the
 whole horizon instead, the lag is made up by the deck feet driving the deck against the
 body, which outruns the board and falls off its front (``docs/tuning.md``).
+
+Only a board below the entry's rolling start (its target less
+:data:`~ridempc.mpc.manoeuvre.REPUSH_BAND`) is behind its strokes: they are laid for a
+board rolling at that speed, and ridden from it (straight, or in alternating turns) they
+gain what they plan. So the lag asked back is at most how far the board is below that
+start (:func:`stroke_catch_up`), which fades it out continuously as the board reaches it;
+asked of faster boards too, a stroke at 0.5-0.6 m/s drove the body 0.3 m/s ahead of the
+deck in 0.3 s, and the handover that followed kicked the board.
 """
 
 from __future__ import annotations
@@ -72,13 +80,20 @@ def catch_up(problem: MpcProblem, lag: float, ground_left: float) -> Array:
 
 
 def stroke_catch_up(
-    problem: MpcProblem, layout: StateLayout, reference: MotionReference, t: float, speed: float
+    problem: MpcProblem,
+    layout: StateLayout,
+    reference: MotionReference,
+    t: float,
+    speed: float,
+    rolling_start: float,
 ) -> Array:
     """:func:`catch_up` of a re-push's tick: the lag of the board's ``speed`` [m/s] behind
-    ``problem``'s reference at node 0, made up over ``reference``'s ground time left from
-    ``t`` [s] (reference time)."""
+    ``problem``'s reference at node 0, but no more than it is below the entry's
+    ``rolling_start`` [m/s], made up over ``reference``'s ground time left from ``t`` [s]
+    (reference time)."""
     board_speed = layout.speed(layout.prefixes[0])
     if board_speed is None:
         return np.zeros(len(problem.state_reference))
     lag = float(problem.state_reference[0, board_speed]) - float(speed)
-    return catch_up(problem, lag, ground_time_left(reference, t))
+    below = float(rolling_start) - float(speed)
+    return catch_up(problem, min(lag, below), ground_time_left(reference, t))

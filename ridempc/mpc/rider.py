@@ -931,7 +931,8 @@ class MpcRider(Controller):
         if inputs.coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
         elif inputs.manoeuvre[0] == REPUSH:  # from the first push: the planned gain
-            extra = stroke_catch_up(problem, self.layout, self.mpc.reference, t_ref, speed)
+            start = inputs.manoeuvre[1] - REPUSH_BAND  # the entry's rolling start
+            extra = stroke_catch_up(problem, self.layout, self.mpc.reference, t_ref, speed, start)
             problem = shifted_speeds(problem, self.layout, speed, extra)  # and the lag made up
         balance = None
         if self.selector.commands_roll(names, inputs.roll):
