@@ -8,7 +8,6 @@ from ridempc.controllers.base import Controller
 from ridempc.controllers.stand import StandController
 from ridempc.estimation import EstimatedState
 from ridempc.estimation.state import BoardEstimate
-from ridempc.mpc.problem import MpcProblem
 from ridempc.scenarios.scenario import Command, Scenario
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -86,29 +85,4 @@ def board_estimate(t: float, boards: tuple[BoardEstimate, ...]) -> EstimatedStat
         foot_position=np.zeros((2, 3)),
         foot_velocity=np.zeros((2, 3)),
         boards=boards,
-    )
-
-
-def bare_problem(
-    x0: np.ndarray, window: np.ndarray, dt: float, contacts: tuple[tuple, ...] = ()
-) -> MpcProblem:
-    """An MPC problem around the state reference ``window`` (its dynamics unused), with
-    the per-step ``contacts`` given."""
-    n, nx, nu = len(window) - 1, len(x0), 2
-    return MpcProblem(
-        initial_state=x0,
-        A=np.tile(np.eye(nx), (n, 1, 1)),
-        B=np.zeros((n, nx, nu)),
-        c=np.zeros((n, nx)),
-        state_reference=window,
-        input_reference=np.zeros((n, nu)),
-        state_weights=np.ones(nx),
-        input_weights=np.ones(nu),
-        input_lower=-np.ones((n, nu)),
-        input_upper=np.ones((n, nu)),
-        constraint_matrix=np.zeros((n, 0, nu)),
-        constraint_lower=np.zeros((n, 0)),
-        constraint_upper=np.zeros((n, 0)),
-        dt=dt,
-        contacts=contacts,
     )

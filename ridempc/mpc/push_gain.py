@@ -24,22 +24,16 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ridempc.mpc.manoeuvre import StateLayout
 from ridempc.mpc.problem import MpcProblem
 
 __all__ = ["shifted_speeds"]
 
-Array = NDArray[np.float64]
 
-
-def shifted_speeds(
-    problem: MpcProblem, layout: StateLayout, speed: float, extra: Array | None = None
-) -> MpcProblem:
+def shifted_speeds(problem: MpcProblem, layout: StateLayout, speed: float) -> MpcProblem:
     """``problem`` with its reference's speeds shifted to start at the board's ``speed``
-    [m/s] (see the module docstring), each node's by ``extra`` [m/s] more where given (a
-    lag made up, :mod:`.push_catchup`), the places by the extra speed integrated too."""
+    [m/s] (see the module docstring)."""
     names = layout.names
     platform = layout.prefixes[0]
     states = problem.state_reference.copy()
@@ -47,15 +41,12 @@ def shifted_speeds(
     heading = layout.heading(platform)
     if board_speed is None or heading is None:
         return problem
-    change = np.full(len(states), float(speed) - float(states[0, board_speed]))
-    if extra is not None:
-        change += extra
+    change = float(speed) - float(states[0, board_speed])
     direction = np.column_stack([np.cos(states[:, heading]), np.sin(states[:, heading])])
-    steps = direction[:-1] * (change[:-1, None] * problem.dt)
-    travelled = np.vstack([np.zeros(2), np.cumsum(steps, axis=0)])
+    travelled = np.vstack([np.zeros(2), np.cumsum(direction[:-1] * problem.dt, axis=0)])
     for prefix in ("com_", *layout.prefixes):
-        states[:, [names[f"{prefix}x"], names[f"{prefix}y"]]] += travelled
-    states[:, [names["vx"], names["vy"]]] += change[:, None] * direction
+        states[:, [names[f"{prefix}x"], names[f"{prefix}y"]]] += change * travelled
+    states[:, [names["vx"], names["vy"]]] += change * direction
     for prefix in layout.prefixes:
         index = layout.speed(prefix)
         if index is not None:

@@ -144,7 +144,6 @@ from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.push_catchup import stroke_catch_up
 from ridempc.mpc.push_gain import shifted_speeds
 from ridempc.mpc.push_handover import deviation_deferred
 from ridempc.mpc.push_side import PushSide, first_stride
@@ -931,9 +930,7 @@ class MpcRider(Controller):
         if inputs.coasting or self._blend is not None:
             problem = self.selector.coasting(problem, self.layout, speed)
         elif inputs.manoeuvre[0] == REPUSH:  # from the first push: the planned gain
-            start = inputs.manoeuvre[1] - REPUSH_BAND  # the entry's rolling start
-            extra = stroke_catch_up(problem, self.layout, self.mpc.reference, t_ref, speed, start)
-            problem = shifted_speeds(problem, self.layout, speed, extra)  # and the lag made up
+            problem = shifted_speeds(problem, self.layout, speed)
         balance = None
         if self.selector.commands_roll(names, inputs.roll):
             balance = self.mpc.static_shift(t_ref, names["board_roll"], self.layout.rider_states)
