@@ -968,7 +968,8 @@ class MpcRider(Controller):
             return
         if not balancing:
             self.payload.reset()
-        payload = self.payload.update(estimate.q, self.map.com(estimate))
+        open_loop = self.handover.on_backup  # the backup rides: the estimate closes no loop
+        payload = self.payload.update(estimate.q, self.map.com(estimate), estimate.v, open_loop)
         for joint, inertia in enumerate(payload.inertias(self.payload.nominal_inertias)):
             self.pinocchio.model.inertias[joint] = inertia
             self.wbc.model.model.inertias[joint] = inertia
