@@ -22,6 +22,7 @@ import pytest
 
 from ridempc.controllers import make_controller
 from ridempc.errors import ConfigError
+from ridempc.mpc.handover import RETURN_DWELL_S
 from ridempc.mpc.payload import (
     GRAVITY,
     MASS_DEADBAND,
@@ -29,6 +30,8 @@ from ridempc.mpc.payload import (
     PayloadEstimate,
     PayloadEstimator,
 )
+from ridempc.mpc.readiness import start_readiness
+from ridempc.pair_description import load_pair_description
 from ridempc.robots import load_robot
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.scenarios.scenario import ParameterChange, Scenario
@@ -117,10 +120,13 @@ SWAY_M = 0.01  # [m] sideways, the PD's start sway on the Hovershoes (1-3 cm acr
 SWAY_HZ = 1.7  # [Hz] the PD's sway under Cassie on the Hovershoes
 
 
-def _swaying_estimate(open_loop: bool, seconds: float) -> tuple[PayloadEstimate, float, np.ndarray]:
+def _swaying_estimate(
+    open_loop: bool, seconds: float, settling: list[np.ndarray] | None = None
+) -> tuple[PayloadEstimate, float, np.ndarray]:
     """The estimate after ``seconds`` of a swaying stance with +20 % of Cassie's mass 4 cm
     ahead of and 4 cm right of her centre of mass (the whole moved 0.67 cm each way); its
-    true mass beyond the model's [kg] and the true offset [m] (world, here the base's)."""
+    true mass beyond the model's [kg] and the model's centre of mass's error [m] (world);
+    ``settling`` collects what the takeover watches, MPC step by MPC step."""
     robot = load_robot("cassie")
     pinocchio = build_pinocchio_robot(robot)
     estimator = PayloadEstimator(robot, pinocchio, MPC_DT)
@@ -149,6 +155,8 @@ def _swaying_estimate(open_loop: bool, seconds: float) -> tuple[PayloadEstimate,
             estimator.accumulate(loads, np.ones(len(loads), dtype=bool), torque, imu)
         com = np.array(pin.centerOfMass(model, data, q))
         estimate = estimator.update(q, com, v, open_loop=open_loop)
+        if settling is not None:
+            settling.append(estimate.settling())
         for joint, inertia in enumerate(estimate.inertias(estimator.nominal_inertias)):
             model.inertias[joint] = inertia
     com_model = np.array(pin.centerOfMass(model, data, q0))
@@ -168,6 +176,20 @@ def test_a_swaying_stance_on_the_backup_is_read_within_half_a_second() -> None:
     assert np.linalg.norm(error[:2]) <= 0.0025
     slow, _, slow_error = _swaying_estimate(open_loop=False, seconds=0.5)
     assert np.linalg.norm(slow_error[:2]) >= 0.005  # the closed loop's 2 s integration
+
+
+def test_the_takeover_finds_the_swaying_estimate_settled_once_it_is_right() -> None:
+    """The running mean's steps shrink as 1/k: the takeover's rule (the pair's window and
+    tolerances) finds it settled within a second, by when its offset is within 2.5 mm."""
+    history: list[np.ndarray] = []
+    _swaying_estimate(open_loop=True, seconds=1.5, settling=history)
+    stage = load_pair_description("cassie", "hovershoes").stages.takeover
+    readiness = start_readiness(stage, RETURN_DWELL_S)
+    assert readiness is not None
+    ready = [readiness.update(k * MPC_DT, e, True, False) for k, e in enumerate(history)]
+    assert True in ready and ready.index(True) * MPC_DT <= 1.0
+    _, _, error = _swaying_estimate(open_loop=True, seconds=(ready.index(True) + 1) * MPC_DT)
+    assert np.linalg.norm(error[:2]) <= 0.0025
 
 
 def test_no_payload_reads_none() -> None:
