@@ -40,10 +40,11 @@ MPC's own ride, where the estimate closes a loop through the balance (a faster o
 sway back). While the backup balance rides (:mod:`ridempc.mpc.handover`: the ride's start,
 a handover) the estimate closes no loop, and both are the *running mean* of the readings
 taken so far, the least-squares estimate of a constant (gain :math:`1/k` at the
-:math:`k`-th reading, never below the slow loop's :math:`\\Delta t / T`) with no dead band:
-the error of a mean of :math:`k` readings falls as :math:`1/\\sqrt k`, where a low pass
-keeps its time constant's noise for good (:meth:`PayloadEstimator.update`'s
-``open_loop``). The estimate enters the
+:math:`k`-th reading, never below the slow loop's :math:`\\Delta t / T`): the error of a
+mean of :math:`k` readings falls as :math:`1/\\sqrt k`, where a low pass keeps its time
+constant's noise for good (:meth:`PayloadEstimator.update`'s ``open_loop``). The mean's
+offset enters the models shortened by :data:`MEAN_DEADBAND_M` (half the slow loop's dead
+band), the mass by the same :data:`MASS_DEADBAND`. The estimate enters the
 models' body inertias (:meth:`PayloadEstimate.inertias`): a heavier rider carries
 :math:`\\Delta m = \\hat m - m_0` on its base (a payload), a lighter one is lighter
 throughout (every body scaled), and the base's centre of mass is moved by :math:`\\delta` so
@@ -79,6 +80,7 @@ if TYPE_CHECKING:
 __all__ = [
     "MASS_BOUND",
     "MASS_DEADBAND",
+    "MEAN_DEADBAND_M",
     "PayloadEstimate",
     "PayloadEstimator",
     "SHIFT_DEADBAND_M",
@@ -107,6 +109,11 @@ SHIFT_DEADBAND_M: float = 0.01
 # the sway back (the estimate swung +-7 cm across the feet); about seven times the balance's
 # own time (0.3 s) keeps it to the steady part.
 SHIFT_TIME_CONSTANT_S: float = 2.0
+# [m] the running mean's own dead band, applied to what enters the models: over the start's
+# first second the mean reads up to 4 mm without a payload (the PD's landing and settling;
+# library yaw-steps seed 0: -0.4 cm at the takeover), and fed in, that bias cost the
+# library's tracking.
+MEAN_DEADBAND_M: float = 0.005
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
@@ -157,6 +164,12 @@ class PayloadEstimate:
         return out
 
 
+def _shrunk(offset: Array, deadband: float) -> Array:
+    """``offset`` [m] shortened by ``deadband`` [m] (zero within it)."""
+    length = max(float(np.linalg.norm(offset)), 1e-9)
+    return offset * max(0.0, 1.0 - deadband / length)
+
+
 class PayloadEstimator:
     """Estimates :class:`PayloadEstimate` from the stance's loads (module docstring).
 
@@ -194,6 +207,7 @@ class PayloadEstimator:
         self.dt = dt
         self._vcom: Array | None = None  # [m/s] the model's centre-of-mass velocity, last step
         self._readings = 0  # the readings taken while the backup rode (the running mean's k)
+        self.mean_shift = np.zeros(3)  # [m] the offset readings' running mean, base frame
 
     def _com_velocity(self, q: Array, v: Array | None) -> Array | None:
         """The nominal model's centre-of-mass velocity [m/s] (world), None without ``v``."""
@@ -278,12 +292,14 @@ class PayloadEstimator:
         offset = np.zeros(3)
         offset[:2] = pressure[:2] + height * accel[:2] / specific[2] - com[:2]
         base_rotation = pin.XYZQUATToSE3(np.asarray(q[:7])).rotation
-        if open_loop:
-            gain = slow
+        if open_loop:  # the mean of the readings (the estimate in force added back)
+            reading = self.estimate.shift + base_rotation.T @ offset
+            self.mean_shift = self.mean_shift + slow * (reading - self.mean_shift)
+            shift = _shrunk(self.mean_shift, MEAN_DEADBAND_M)
         else:
-            length = max(float(np.linalg.norm(offset)), 1e-9)
-            offset *= max(0.0, 1.0 - SHIFT_DEADBAND_M / length)
-            gain = self.alpha_shift
-        shift = self.estimate.shift + gain * base_rotation.T @ offset
+            shift = self.estimate.shift + self.alpha_shift * base_rotation.T @ _shrunk(
+                offset, SHIFT_DEADBAND_M
+            )
+            self.mean_shift = shift.copy()
         self.estimate = PayloadEstimate(float(excess * self.mass0), shift, self.mass0)
         return self.estimate
