@@ -10,6 +10,7 @@
   rides (the estimate in no loop): the running mean with the sway's acceleration term
   recovers mass and offset within half a second, where the slow closed-loop integration
   has taken up a fraction of the offset.
+- The payload stage passes the estimator the backup's riding and the estimate's velocity.
 - A negative payload scales the rider's bodies: the robot's mass is that much less, its
   centre of mass where it was.
 """
@@ -238,3 +239,37 @@ def test_a_negative_payload_is_a_lighter_rider() -> None:
         heavy = ParameterChange(parameter="payload", body="base", mass=-1.5 * robot.mass)
         Simulation(scene, make_controller("stand", robot, "none"),
                    Scenario(name="none", duration=0.01, changes=(heavy,)))  # fmt: skip
+
+
+def test_the_payload_stage_reads_the_running_mean_only_while_the_backup_rides() -> None:
+    """The stage hands the estimator the last control tick's ``on_backup`` and the estimate's
+    velocity (the sway's acceleration term)."""
+    from types import SimpleNamespace
+
+    from ridempc.mpc.stages.payload_models import PayloadModels
+
+    calls: list[tuple[object, bool]] = []
+
+    class _Estimator:
+        estimate = SimpleNamespace(mass=0.0, inertias=lambda nominal: [])
+        nominal_inertias: list[pin.Inertia] = []
+
+        def accumulate(self, *args: object) -> None: ...
+
+        def reset(self) -> None: ...
+
+        def update(self, q: object, com: object, v: object, open_loop: bool) -> object:
+            calls.append((v, open_loop))
+            return self.estimate
+
+    stage = PayloadModels(_Estimator(), [], lambda e: np.zeros(3), 8)  # type: ignore[arg-type]
+    estimate = SimpleNamespace(q=np.zeros(7), v=np.ones(6), contact=np.ones(2, dtype=bool))
+    sensors = SimpleNamespace(motor_torque=np.zeros(10), imu=None)
+    mpc_tick = SimpleNamespace(estimate=estimate, balancing=True, diagnostics={})
+    for on_backup in (True, False):
+        control = SimpleNamespace(sensors=sensors, estimate=estimate, loads=np.ones(2),
+                                  on_backup=on_backup)  # fmt: skip
+        stage.observe(control)  # type: ignore[arg-type]
+        stage.absorb(mpc_tick)  # type: ignore[arg-type]
+    assert [open_loop for _, open_loop in calls] == [True, False]
+    assert all(v is estimate.v for v, _ in calls)
