@@ -19,10 +19,14 @@ torques and the IMU):
   :math:`a_s = \\partial z_s / \\partial q_a` [m/rad] the site's vertical Jacobian column
   (one site: all of it there). The sites' centre of pressure
   :math:`p = \\sum f_s p_s / \\sum f_s` stands under the centre of mass in a static
-  balance, :math:`c_{xy} = p_{xy}` (the zero-moment point's term
-  :math:`h\\, \\ddot c_{xy} / g` is left out: read from the pelvis's IMU or the estimate's
-  velocities it swung by up to 9 cm over an MPC step); the offset is what it differs by
-  from the model's centre of mass (the estimate already in it), integrated. Only the directions the
+  balance; swaying, the zero-moment point's term carries its acceleration,
+  :math:`c_{xy} = p_{xy} + h\\, \\ddot c_{xy} / f_z` (:math:`h` [m] the centre of mass
+  above the feet), with :math:`\\ddot c` the difference of the model's centre-of-mass
+  velocity over the MPC step. One step's difference is noisy (the velocity's noise over
+  1/30 s: several centimetres), but summed over the steps it telescopes to
+  :math:`h\\,(\\dot c_k - \\dot c_0) / (f_z\\, t_k)`: a mean of the readings needs only
+  that the sway's velocity stays bounded. The offset is what the corrected reading differs
+  by from the model's centre of mass (the estimate already in it). Only the directions the
   sites span are seen (a line of sites: only along it); :math:`c_z` is not observed.
 
 Both are averaged over an MPC step, only while every foot is in contact and the rider is not
@@ -31,7 +35,16 @@ a manoeuvre's accelerations move the centre of pressure off the centre of mass. 
 ratio :math:`\\hat m / m_0` is low-passed with the time constant :data:`TIME_CONSTANT_S`,
 its excess over 1 shrunk by :data:`MASS_DEADBAND` (the load signals' calibration) and held
 within :data:`MASS_BOUND`; the offset's error, shrunk by :data:`SHIFT_DEADBAND_M`, is
-integrated with the time constant :data:`SHIFT_TIME_CONSTANT_S`. The estimate enters the
+integrated with the time constant :data:`SHIFT_TIME_CONSTANT_S`. That slow loop is for the
+MPC's own ride, where the estimate closes a loop through the balance (a faster one fed the
+sway back). While the backup balance rides (:mod:`ridempc.mpc.handover`: the ride's start,
+a handover) the estimate closes no loop, and both are the *running mean* of the readings
+taken so far, the least-squares estimate of a constant (gain :math:`1/k` at the
+:math:`k`-th reading, never below the slow loop's :math:`\\Delta t / T`): the error of a
+mean of :math:`k` readings falls as :math:`1/\\sqrt k`, where a low pass keeps its time
+constant's noise for good (:meth:`PayloadEstimator.update`'s ``open_loop``). The mean's
+offset enters the models shortened by :data:`MEAN_DEADBAND_M` (half the slow loop's dead
+band), the mass by the same :data:`MASS_DEADBAND`. The estimate enters the
 models' body inertias (:meth:`PayloadEstimate.inertias`): a heavier rider carries
 :math:`\\Delta m = \\hat m - m_0` on its base (a payload), a lighter one is lighter
 throughout (every body scaled), and the base's centre of mass is moved by :math:`\\delta` so
@@ -67,6 +80,7 @@ if TYPE_CHECKING:
 __all__ = [
     "MASS_BOUND",
     "MASS_DEADBAND",
+    "MEAN_DEADBAND_M",
     "PayloadEstimate",
     "PayloadEstimator",
     "SHIFT_DEADBAND_M",
@@ -95,6 +109,11 @@ SHIFT_DEADBAND_M: float = 0.01
 # the sway back (the estimate swung +-7 cm across the feet); about seven times the balance's
 # own time (0.3 s) keeps it to the steady part.
 SHIFT_TIME_CONSTANT_S: float = 2.0
+# [m] the running mean's own dead band, applied to what enters the models: over the start's
+# first second the mean reads up to 4 mm without a payload (the PD's landing and settling;
+# library yaw-steps seed 0: -0.4 cm at the takeover), and fed in, that bias cost the
+# library's tracking.
+MEAN_DEADBAND_M: float = 0.005
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
@@ -145,6 +164,12 @@ class PayloadEstimate:
         return out
 
 
+def _shrunk(offset: Array, deadband: float) -> Array:
+    """``offset`` [m] shortened by ``deadband`` [m] (zero within it)."""
+    length = max(float(np.linalg.norm(offset)), 1e-9)
+    return offset * max(0.0, 1.0 - deadband / length)
+
+
 class PayloadEstimator:
     """Estimates :class:`PayloadEstimate` from the stance's loads (module docstring).
 
@@ -179,6 +204,17 @@ class PayloadEstimator:
         self._ratio = 1.0  # [-] the low-passed measured mass over the model's
         self._sum: Array | None = None  # the readings since the last update, summed
         self._count = 0
+        self.dt = dt
+        self._vcom: Array | None = None  # [m/s] the model's centre-of-mass velocity, last step
+        self._readings = 0  # the readings taken while the backup rode (the running mean's k)
+        self.mean_shift = np.zeros(3)  # [m] the offset readings' running mean, base frame
+
+    def _com_velocity(self, q: Array, v: Array | None) -> Array | None:
+        """The nominal model's centre-of-mass velocity [m/s] (world), None without ``v``."""
+        if v is None:
+            return None
+        pin.centerOfMass(self.model, self.data, q, v)
+        return np.array(self.data.vcom[0])
 
     def reset(self) -> None:
         """Forget the readings since the last :meth:`update`."""
@@ -199,21 +235,34 @@ class PayloadEstimator:
         self._sum = reading if self._sum is None else self._sum + reading
         self._count += 1
 
-    def update(self, q: Array, com: Array) -> PayloadEstimate:
+    def update(
+        self, q: Array, com: Array, v: Array | None = None, open_loop: bool = False
+    ) -> PayloadEstimate:
         """The estimate after one MPC step's readings, at the configuration ``q``
         (Pinocchio), with the model's centre of mass ``com`` [m] (world, with the estimate
-        in it); held where no reading came in with every foot in contact."""
+        in it) and the velocity ``v`` (Pinocchio; None: no sway's acceleration term);
+        held where no reading came in with every foot in contact. ``open_loop``: the
+        estimate closes no loop through the balance (the backup rides): the running mean
+        (module docstring)."""
+        vcom = self._com_velocity(q, v)
         if self._sum is None:
+            self._vcom = None  # a gap: the next reading starts a new run
             return self.estimate
         n = len(self.legs.feet)
         mean = self._sum / self._count
         self.reset()
         loads, torque, specific = mean[:n], mean[n:-3], mean[-3:]
         if specific[2] < 0.5 * GRAVITY or np.sum(loads) <= 0.0:
+            self._vcom = None
             return self.estimate
+        accel = np.zeros(3) if self._vcom is None or vcom is None else (vcom - self._vcom) / self.dt
+        self._vcom = vcom
+        self._readings += 1 if open_loop else 0
+        fast = 1.0 / self._readings if open_loop else 0.0  # the running mean's gain
         forces = loads * self.share  # [N] per foot
         ratio = float(np.sum(forces) / (self.mass0 * specific[2]))
-        self._ratio += self.alpha * (ratio - self._ratio)
+        slow = max(fast, self.alpha_shift)  # open loop: the mean, then the offset's low pass
+        self._ratio += (slow if open_loop else self.alpha) * (ratio - self._ratio)
         excess = self._ratio - 1.0
         excess = math.copysign(min(MASS_BOUND, max(0.0, abs(excess) - MASS_DEADBAND)), excess)
         pin.computeJointJacobians(self.model, self.data, q)
@@ -227,23 +276,30 @@ class PayloadEstimator:
                 points.append(np.mean(sites, axis=0))
                 weights.append(force)
                 continue
-            v, motor = ankle
+            column, motor = ankle
             arms = [
-                pin.getFrameJacobian(self.model, self.data, f, WORLD_ALIGNED)[2, v]
+                pin.getFrameJacobian(self.model, self.data, f, WORLD_ALIGNED)[2, column]
                 for f in foot.sites
             ]
             rows = np.vstack([np.ones(len(arms)), arms])
-            split = np.linalg.lstsq(rows, [force, gravity[v] - torque[motor]], rcond=None)[0]
+            split = np.linalg.lstsq(rows, [force, gravity[column] - torque[motor]], rcond=None)[0]
             points.extend(sites)
             weights.extend(split)
         w = np.asarray(weights)
         p = np.asarray(points)
         pressure = w @ p / np.sum(w)
+        height = float(com[2] - np.mean(p[:, 2]))  # [m] the centre of mass over the sites
         offset = np.zeros(3)
-        offset[:2] = pressure[:2] - com[:2]
-        length = max(float(np.linalg.norm(offset)), 1e-9)
-        offset *= max(0.0, 1.0 - SHIFT_DEADBAND_M / length)
+        offset[:2] = pressure[:2] + height * accel[:2] / specific[2] - com[:2]
         base_rotation = pin.XYZQUATToSE3(np.asarray(q[:7])).rotation
-        shift = self.estimate.shift + self.alpha_shift * base_rotation.T @ offset
+        if open_loop:  # the mean of the readings (the estimate in force added back)
+            reading = self.estimate.shift + base_rotation.T @ offset
+            self.mean_shift = self.mean_shift + slow * (reading - self.mean_shift)
+            shift = _shrunk(self.mean_shift, MEAN_DEADBAND_M)
+        else:
+            shift = self.estimate.shift + self.alpha_shift * base_rotation.T @ _shrunk(
+                offset, SHIFT_DEADBAND_M
+            )
+            self.mean_shift = shift.copy()
         self.estimate = PayloadEstimate(float(excess * self.mass0), shift, self.mass0)
         return self.estimate

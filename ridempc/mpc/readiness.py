@@ -40,9 +40,15 @@ The MPC takes the ride only where it has a command and no failure (the handover'
 check). While it waits, the summary says for what (:meth:`StartReadiness.summary`).
 
 The estimates watched are the ones that learn while the backup rides: the payload's,
-read from the stance's loads. The disturbance observer (:mod:`ridempc.mpc.disturbance`)
-learns from the MPC's own plan's prediction error, which the backup does not follow: it
-is held until the MPC rides, and its probation (:mod:`ridempc.mpc.divergence`) covers it.
+read from the stance's loads, there the running mean of the readings so far
+(:mod:`ridempc.mpc.payload`). Its steps shrink as :math:`1/k`, so a window whose spread is
+within the tolerances is a mean that has stopped moving, near the truth; a slow low pass
+would pass the same test long before it had taken up its offset (its 2 s integration read
+settled at 0.5 s with half a centimetre of a 0.94 cm offset still to come).
+
+The disturbance observer (:mod:`ridempc.mpc.disturbance`) learns from the MPC's own
+plan's prediction error, which the backup does not follow: it is held until the MPC rides,
+and its probation (:mod:`ridempc.mpc.divergence`) covers it.
 
 Each outcome is recorded with its reason (:meth:`StartReadiness.summary`).
 """

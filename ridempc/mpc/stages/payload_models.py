@@ -45,18 +45,25 @@ class PayloadModels:
         vz: int,
     ) -> None:
         self.payload, self._models, self._com, self._vz = payload, tuple(models), com, vz
+        self._open_loop = False  # the backup rode the last control tick: no loop closed
 
     def observe(self, tick: ControlTick) -> None:
         """One control tick's reading of the stance's loads [-] and the sensors."""
         sensors = tick.sensors
         contact = tick.estimate.contact
         self.payload.accumulate(tick.loads, contact, sensors.motor_torque, sensors.imu)
+        self._open_loop = tick.on_backup
 
     def absorb(self, tick: MpcTick) -> None:
-        """The estimate over the last MPC step (dropped unless balancing) into the models."""
+        """The estimate over the last MPC step (dropped unless balancing) into the models:
+        while the backup rides, the running mean of the readings
+        (:meth:`~ridempc.mpc.payload.PayloadEstimator.update`'s ``open_loop``)."""
         if not tick.balancing:
             self.payload.reset()
-        payload = self.payload.update(tick.estimate.q, self._com(tick.estimate))
+        estimate = tick.estimate
+        payload = self.payload.update(
+            estimate.q, self._com(estimate), estimate.v, open_loop=self._open_loop
+        )
         for joint, inertia in enumerate(payload.inertias(self.payload.nominal_inertias)):
             for model in self._models:
                 model.inertias[joint] = inertia
