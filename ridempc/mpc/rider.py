@@ -116,6 +116,7 @@ from ridempc.mpc.delay import predicted_start
 from ridempc.mpc.disturbance import DisturbanceObserver, disturbance_rows
 from ridempc.mpc.divergence import DivergentDeviation, Probation
 from ridempc.mpc.drop import DropDetector
+from ridempc.mpc.flight import DropFlight
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.guidance import steer_onto_lines
@@ -537,6 +538,7 @@ class MpcRider(Controller):
         self._probation = Probation()  # whether the MPC has shown its model holds the rider
         # the platforms falling away under the feet (a step), with the ``drop`` stage
         self._drop = DropDetector() if self.pair.description.stages.drop is not None else None
+        self._flight = DropFlight() if self.pair.description.stages.flight is not None else None
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
@@ -624,6 +626,8 @@ class MpcRider(Controller):
         self.torque_lead.reset()
         if self._drop is not None:
             self._drop.reset()
+        if self._flight is not None:
+            self._flight.reset()
         self._tick = 0
         self._plan = None
         estimate = self.estimator.state
@@ -681,7 +685,13 @@ class MpcRider(Controller):
             np.isfinite(estimate.q).all() and np.isfinite(estimate.v).all()
         ):
             return None, "state estimate not finite"
-        dropping = self._drop is not None and self._drop.update(self.estimator.contact.last_load)
+        feet_vz = estimate.foot_velocity[:, 2]
+        dropping = self._drop is not None and self._drop.update(
+            self.estimator.contact.last_load, float(estimate.base_velocity[2]), feet_vz.max()
+        )
+        if self._flight is not None:  # the drop ridden by the QP, handed over if too long
+            flying = self._flight.update(dropping, estimate)
+            dropping = self._flight.too_long(sensors.time)
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
         if self.payload is not None:
@@ -705,6 +715,8 @@ class MpcRider(Controller):
             return out, f"MPC plan failed (status {self._plan.status})"
         if dropping:
             return out, "every foot's load gone at once (a drop)"
+        if self._flight is not None and flying:
+            return out, None
         slack = self._diagnostics.get("wbc_slack", 0.0)
         if slack > 0.0:
             return out, f"whole-body QP infeasible (slack {slack:.3g})"
@@ -1298,7 +1310,11 @@ class MpcRider(Controller):
                 swing, swing_velocity = self.feet.targets(states, frame, board)
         elif not contact.all():  # without planned feet, a lifted foot holds where it is
             swing = self.wbc.model.foot_points(estimate.q)
-        if not contact.any():
+        swing_acceleration = None
+        if self._flight is not None and self._flight.flying:  # no foot stands: mpc/flight.py
+            contact[:] = False
+            swing, swing_velocity, swing_acceleration = self._flight.swing(estimate)
+        elif not contact.any():
             contact[:] = True
         targets = WbcTargets(
             position=wanted.position,
@@ -1312,6 +1328,7 @@ class MpcRider(Controller):
             site_forces=wanted.site_forces if self._sites_match else None,
             swing_position=swing,
             swing_velocity=swing_velocity,
+            swing_acceleration=swing_acceleration,
             posture=posture,
             board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
