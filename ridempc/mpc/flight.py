@@ -56,6 +56,9 @@ GRAVITY: float = 9.81  # [m/s^2]
 class DropFlight:
     """The flight between a drop and the landing, and the feet's swing targets through it.
 
+    ``update`` each tick with the drop detector's answer; while ``flying``, the whole-body
+    QP is given no foot in contact and ``swing`` as the feet's targets.
+
     Args:
         extend_speed: How fast the feet reach down after the platforms [m/s].
         max_extension: How far they reach at most [m].
@@ -72,6 +75,7 @@ class DropFlight:
         self.max_extension = max_extension
         self._start: float | None = None
         self._offsets = np.zeros((0, 3))  # [m] each foot from the base, at the drop
+        self._sank = False  # whether a foot has sunk faster than SINK_SPEED in this flight
         self._stopped = 0
 
     @property
@@ -81,6 +85,7 @@ class DropFlight:
 
     def reset(self) -> None:
         self._start = None
+        self._sank = False
         self._stopped = 0
 
     def update(self, dropped: bool, estimate: EstimatedState) -> bool:
@@ -91,16 +96,19 @@ class DropFlight:
             estimate: The state estimate (its time, base and feet).
 
         Returns:
-            True from a drop until every foot has sunk slower than ``SINK_SPEED`` for
-            ``LAND_TICKS`` ticks.
+            True from a drop until, once a foot has sunk faster than ``SINK_SPEED``, every
+            foot has sunk slower for ``LAND_TICKS`` ticks (a landing ends a fall).
         """
         if self._start is None:
             if dropped:
                 self._start = estimate.time
                 self._offsets = estimate.foot_position - estimate.base_position
+                self._sank = False
                 self._stopped = 0
             return self.flying
-        landed = float(np.min(estimate.foot_velocity[:, 2])) >= -SINK_SPEED
+        sinking = float(np.min(estimate.foot_velocity[:, 2]))
+        self._sank = self._sank or sinking < -SINK_SPEED
+        landed = self._sank and sinking >= -SINK_SPEED
         self._stopped = self._stopped + 1 if landed else 0
         if self._stopped >= LAND_TICKS:
             self._start = None
