@@ -55,6 +55,9 @@ def test_a_flight_lasts_from_the_drop_to_the_feet_stopped() -> None:
     stopped = [flight.update(False, _estimate(0.05 + (k + 1) * DT, 0.0)) for k in range(LAND_TICKS)]
     assert stopped == [True] * (LAND_TICKS - 1) + [False]
     assert not flight.too_long(1.0)
+    assert flight.starts == [0.0]
+    flight.reset()
+    assert flight.starts == []
 
 
 def test_one_foot_still_sinking_is_no_landing() -> None:

@@ -59,6 +59,9 @@ class DropFlight:
     ``update`` each tick with the drop detector's answer; while ``flying``, the whole-body
     QP is given no foot in contact and ``swing`` as the feet's targets.
 
+    Attributes:
+        starts: When each flight of the ride began [s] (``summary.json``'s ``flights_s``).
+
     Args:
         extend_speed: How fast the feet reach down after the platforms [m/s].
         max_extension: How far they reach at most [m].
@@ -77,6 +80,7 @@ class DropFlight:
         self._offsets = np.zeros((0, 3))  # [m] each foot from the base, at the drop
         self._sank = False  # whether a foot has sunk faster than SINK_SPEED in this flight
         self._stopped = 0
+        self.starts: list[float] = []  # [s] when each flight of the ride began
 
     @property
     def flying(self) -> bool:
@@ -87,6 +91,7 @@ class DropFlight:
         self._start = None
         self._sank = False
         self._stopped = 0
+        self.starts = []
 
     def update(self, dropped: bool, estimate: EstimatedState) -> bool:
         """Take this tick's drop detection and estimate; whether the drop is in the air.
@@ -102,6 +107,7 @@ class DropFlight:
         if self._start is None:
             if dropped:
                 self._start = estimate.time
+                self.starts.append(estimate.time)
                 self._offsets = estimate.foot_position - estimate.base_position
                 self._sank = False
                 self._stopped = 0

@@ -1391,6 +1391,7 @@ class MpcRider(Controller):
         out["deviation_divergent_max"] = self._divergence.peak
         out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
         out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
+        out["flights_s"] = list(self._flight.starts) if self._flight is not None else None
         out["safe_hold"] = (
             None
             if self._hold_reason is None
