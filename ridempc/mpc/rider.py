@@ -689,8 +689,8 @@ class MpcRider(Controller):
         dropping = self._drop is not None and self._drop.update(
             self.estimator.contact.last_load, float(estimate.base_velocity[2]), feet_vz.max()
         )
-        if self._flight is not None:  # the drop ridden by the QP, handed over if too long
-            flying = self._flight.update(dropping, estimate)
+        if self._flight is not None:  # the drop ridden by the QP (the backup rides its own)
+            flying = self._flight.update(dropping and not self.handover.on_backup, estimate)
             dropping = self._flight.too_long(sensors.time)
         if self.shoe_heading is not None:
             estimate = self.shoe_heading(estimate)
