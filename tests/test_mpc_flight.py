@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from ridempc.estimation.state import EstimatedState
-from ridempc.mpc.drop import SINK_SPEED
+from ridempc.mpc.divergence import DivergentDeviation
+from ridempc.mpc.drop import SINK_SPEED, DropDetector
 from ridempc.mpc.flight import (
     EXTEND_SPEED,
     LAND_TICKS,
@@ -16,6 +17,8 @@ from ridempc.mpc.flight import (
     MAX_EXTENSION,
     DropFlight,
 )
+from ridempc.mpc.plan import Plan
+from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, handover_triggers
 from ridempc.pair_description import load_pair_description
 from tests.helpers import board_estimate
 
@@ -101,3 +104,22 @@ def test_bad_settings_are_refused() -> None:
 def test_the_hovershoes_pair_rides_its_drops() -> None:
     assert load_pair_description("cassie", "hovershoes").stages.flight is not None
     assert load_pair_description("cassie", "segway").stages.flight is None
+
+
+def test_the_flight_takes_the_drop_s_place_among_the_triggers() -> None:
+    """While the drop is in the air only a flight longer than any step's hands over."""
+    flight = DropFlight(DropWatch(DropDetector()))
+    triggers = handover_triggers(flight.watch, None, flight)
+    assert flight in triggers and flight.watch not in triggers
+    flight.update(True, _estimate(0.0, -1.0))
+    calm = HandoverCheck(
+        Plan(np.zeros((2, 1)), np.zeros((1, 1)), np.zeros(1), "solved", 0.0, False),
+        0.0,
+        0.0,
+        False,
+        True,
+        DivergentDeviation(),
+    )
+    assert flight(calm) is None
+    flight._now = LONGEST_S + DT
+    assert "a drop" in str(flight(calm))

@@ -27,6 +27,9 @@ from numpy.typing import NDArray
 
 from ridempc.estimation.state import EstimatedState
 from ridempc.mpc.drop import SINK_SPEED
+from ridempc.mpc.stages.base import ControlTick
+from ridempc.mpc.stages.feet_targets import FootTargets
+from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck
 
 __all__ = [
     "EXTEND_SPEED",
@@ -56,26 +59,36 @@ GRAVITY: float = 9.81  # [m/s^2]
 class DropFlight:
     """The flight between a drop and the landing, and the feet's swing targets through it.
 
-    ``update`` each tick with the drop detector's answer; while ``flying``, the whole-body
-    QP is given no foot in contact and ``swing`` as the feet's targets.
+    A stage of the rider (:mod:`~ridempc.mpc.stages.base`): a tick observer after the drop's
+    watch (``observe``: a flight starts on its drop while the MPC rides), the drop's
+    handover trigger in the watch's place (``__call__``: only a flight longer than any
+    step's), and, while ``flying``, the feet's targets (``feet``: no foot in contact, each
+    swinging after its platform); the rider asks no later trigger while it flies.
 
     Attributes:
         starts: When each flight of the ride began [s] (``summary.json``'s ``flights_s``).
 
     Args:
+        watch: The drop's watch, observed before this stage each tick (None: ``update``
+            is called directly).
         extend_speed: How fast the feet reach down after the platforms [m/s].
         max_extension: How far they reach at most [m].
     """
 
     def __init__(
-        self, extend_speed: float = EXTEND_SPEED, max_extension: float = MAX_EXTENSION
+        self,
+        watch: DropWatch | None = None,
+        extend_speed: float = EXTEND_SPEED,
+        max_extension: float = MAX_EXTENSION,
     ) -> None:
         if not extend_speed > 0.0 or not max_extension > 0.0:
             raise ValueError(
                 f"flight: extend_speed {extend_speed} and max_extension {max_extension} must be > 0"
             )
+        self.watch = watch
         self.extend_speed = extend_speed
         self.max_extension = max_extension
+        self._now = 0.0  # [s] the last tick observed
         self._start: float | None = None
         self._offsets = np.zeros((0, 3))  # [m] each foot from the base, at the drop
         self._sank = False  # whether a foot has sunk faster than SINK_SPEED in this flight
@@ -119,6 +132,23 @@ class DropFlight:
         if self._stopped >= LAND_TICKS:
             self._start = None
         return self.flying
+
+    def observe(self, tick: ControlTick) -> None:
+        """Take this tick's drop (the watch's, observed first) while the MPC rides."""
+        self._now = tick.sensors.time
+        dropped = self.watch is not None and self.watch.dropping and not tick.on_backup
+        self.update(dropped, tick.estimate)
+
+    def __call__(self, check: HandoverCheck) -> str | None:
+        """The drop's handover: a flight longer than any step's."""
+        return "every foot's load gone at once (a drop)" if self.too_long(self._now) else None
+
+    def feet(self, feet: FootTargets, estimate: EstimatedState) -> tuple[FootTargets, Array]:
+        """The feet's targets through the flight: none in contact, each swinging after its
+        platform (``swing``), and the swing's feedforward acceleration [m/s^2]."""
+        position, velocity, acceleration = self.swing(estimate)
+        contact = np.zeros_like(feet.contact)
+        return FootTargets(contact, position, velocity, feet.posture), acceleration
 
     def too_long(self, now: float) -> bool:
         """Whether this flight has outlasted any step's (``LONGEST_S``)."""
