@@ -232,6 +232,7 @@ class Stages(_Frozen):
     disturbance: DisturbanceStage | None = None
     takeover: TakeoverStage | None = None
     drop: Used | None = None
+    flight: Used | None = None
     impulse: ImpulseStage | None = None
 
     def used(self) -> tuple[str, ...]:
@@ -258,6 +259,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "disturbance": (frozenset(), ()),
     "takeover": (frozenset(), ()),
     "drop": (frozenset(), ()),
+    "flight": (frozenset(), ("drop",)),
     "impulse": (frozenset(), ()),
 }
 

@@ -159,6 +159,7 @@ def test_each_pair_file_stage_is_in_its_protocol_list(robot: str, board: str) ->
         "SteadyDrift": stages.disturbance,
         "PayloadModels": stages.payload,
         "DropWatch": stages.drop,
+        "DropFlight": stages.flight,
         "PushWatch": stages.impulse,
         "ShoeUpdate": stages.shoe_observer,
     }

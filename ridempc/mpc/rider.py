@@ -8,8 +8,9 @@ in the order they act, in one place, :meth:`MpcRider._build_stages` (``observers
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
    board from its own feet), each shoe's heading from its direction of travel
    (:mod:`~ridempc.mpc.shoe_heading`), and updates the **tick observers** (the platforms
-   falling away, :class:`~ridempc.mpc.stages.triggers.DropWatch`; the stance's loads for the
-   payload, :mod:`~ridempc.mpc.stages.payload_models`);
+   falling away, :class:`~ridempc.mpc.stages.triggers.DropWatch`, and the drop's flight,
+   :class:`~ridempc.mpc.flight.DropFlight`; the stance's loads for the payload,
+   :mod:`~ridempc.mpc.stages.payload_models`);
 2. every 15th tick (30 Hz), chooses the manoeuvre the command asks for
    (:mod:`~ridempc.mpc.stages.manoeuvre_choice`: a push-off or a speed change follows its
    library trajectory, then rides on; on the skateboard it coasts and pushes again), reads the
@@ -83,6 +84,7 @@ from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.delay import predicted_start
 from ridempc.mpc.divergence import DivergentDeviation, Probation
 from ridempc.mpc.drop import DropDetector
+from ridempc.mpc.flight import DropFlight
 from ridempc.mpc.foot_spread import spread_lines
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.handover import (
@@ -360,6 +362,8 @@ class MpcRider(Controller):
         self._probation = Probation()  # whether the MPC has shown its model holds the rider
         # the platforms falling away under the feet (a step), with the ``drop`` stage
         self.drop_watch = DropWatch(DropDetector()) if stages.drop is not None else None
+        # the drop ridden by the whole-body QP, the feet after the platforms (``flight``)
+        self.flight = DropFlight(self.drop_watch) if stages.flight is not None else None
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
@@ -396,11 +400,13 @@ class MpcRider(Controller):
         """Every list of stages, each in the order its stages act (one protocol a list,
         :mod:`ridempc.mpc.stages.base`): where a new stage is added."""
         shoes = ShoeUpdate(self.shoes) if self.shoes is not None else None
-        self.observers: tuple[TickObserver, ...] = present(self.drop_watch, self.payload_models)
+        self.observers: tuple[TickObserver, ...] = present(
+            self.drop_watch, self.flight, self.payload_models
+        )
         self.wbc_observers: tuple[TickObserver, ...] = present(shoes, self.push_watch)
         self.drifts: tuple[DriftSource, ...] = self._drift_sources()
         self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
-        self.triggers = handover_triggers(self.drop_watch, self.push_watch)
+        self.triggers = handover_triggers(self.drop_watch, self.push_watch, self.flight)
 
     def _drift_sources(self) -> tuple[DriftSource, ...]:
         """The disturbance observers whose drifts the MPC's rates carry, in the order they
@@ -442,6 +448,8 @@ class MpcRider(Controller):
         self.torque_lead.reset()
         if self.drop_watch is not None:
             self.drop_watch.reset()
+        if self.flight is not None:
+            self.flight.reset()
         self._tick = 0
         self._plan = None
         estimate = self.estimator.state
@@ -535,6 +543,8 @@ class MpcRider(Controller):
             reason = trigger(check)
             if reason is not None:
                 return out, reason
+            if trigger is self.flight and self.flight.flying:  # the rest wait for the landing
+                break
         return out, None
 
     def _fit(self) -> bool:
@@ -817,6 +827,9 @@ class MpcRider(Controller):
         assert self._support is not None  # set by the MPC tick, which runs first
         t_ref = self.manoeuvre.reference_time(now)
         feet = self.feet_targets(self._support, t_ref, estimate, self._plan_frame)
+        swing_acceleration = None
+        if self.flight is not None and self.flight.flying:  # no foot stands: mpc/flight.py
+            feet, swing_acceleration = self.flight.feet(feet, estimate)
         targets = WbcTargets(
             position=wanted.position,
             orientation=wanted.orientation,
@@ -829,6 +842,7 @@ class MpcRider(Controller):
             site_forces=wanted.site_forces if self._sites_match else None,
             swing_position=feet.swing,
             swing_velocity=feet.swing_velocity,
+            swing_acceleration=swing_acceleration,
             posture=feet.posture,
             board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
         )
@@ -888,6 +902,7 @@ class MpcRider(Controller):
         out["deviation_divergent_max"] = self._divergence.peak
         out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
         out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
+        out["flights_s"] = list(self.flight.starts) if self.flight is not None else None
         out["safe_hold"] = (
             None
             if self._hold_reason is None

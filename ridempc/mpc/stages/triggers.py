@@ -105,7 +105,9 @@ class DropWatch:
         self.detector.reset()
 
     def observe(self, tick: ControlTick) -> None:
-        self.dropping = self.detector.update(tick.loads)
+        estimate = tick.estimate
+        rising, feet = float(estimate.base_velocity[2]), estimate.foot_velocity[:, 2]
+        self.dropping = self.detector.update(tick.loads, rising, float(feet.max()))
 
     def __call__(self, check: HandoverCheck) -> str | None:
         return "every foot's load gone at once (a drop)" if self.dropping else None
@@ -153,8 +155,9 @@ class PushWatch:
 
 
 def handover_triggers(
-    drop: DropWatch | None, push: PushWatch | None
+    drop: DropWatch | None, push: PushWatch | None, flight: HandoverTrigger | None = None
 ) -> tuple[HandoverTrigger, ...]:
     """The triggers in the order asked (the first reason is the one recorded), with the
-    pair's watches where it has them."""
-    return present(plan_failed, drop, needs_slack, push, deviated, diverging)
+    pair's watches where it has them; a drop's flight (:mod:`~ridempc.mpc.flight`) in the
+    drop's place, which it rides."""
+    return present(plan_failed, flight or drop, needs_slack, push, deviated, diverging)
