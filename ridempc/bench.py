@@ -48,7 +48,11 @@ and solve), ``controller_physics_ratio`` the rider's wall time over the simulati
 same ride and ``reference_ms`` the machine reference; ``tick_phases_ms`` sorts the
 controller ticks by their place in the MPC's period (:mod:`ridempc.tickphases`: the MPC's
 tick, the plan's take-up and the backup's standby each have one, so the controller tick's
-p99 is theirs; ``steady_p99`` is the other ticks'). With ``profile`` (``--profile``) the
+p99 is theirs; ``steady_p99`` is the other ticks'). ``tick_phases_cpu_ms`` sorts the same
+ticks' CPU time of the loop's thread and ``cpu_real_time_factor`` is the simulated time
+over that thread's CPU time in the loop: on a loaded machine, where wall times swing with
+the other processes, these compare two versions (they leave out the solver process's and
+thread's work, and the loop's waits for them). With ``profile`` (``--profile``) the
 pair rides once more under :class:`~ridempc.tickprofile.PartProfiler`, and ``profile``
 lists each part's hottest functions by their own time.
 
@@ -109,6 +113,8 @@ class PairBench:
     controller_tick_p99_ms: float = float("nan")
     controller_physics_ratio: float = float("nan")
     tick_phases_ms: dict[str, float] = field(default_factory=dict)
+    cpu_real_time_factor: float = float("nan")
+    tick_phases_cpu_ms: dict[str, float] = field(default_factory=dict)
     wbc_solve_median_ms: float = float("nan")
     wbc_solve_p99_ms: float = float("nan")
     mpc_solve_best_p99_ms: float = float("nan")
@@ -569,6 +575,9 @@ def bench_pair(
     out.controller_tick_p99_ms = _stats(result.controller_times.tolist())[1]
     out.controller_physics_ratio = _controller_physics_ratio(result)
     out.tick_phases_ms = _tick_phases(rider, result.controller_times)
+    cpu = result.cpu_time  # the loop's thread's own: what the machine's load adds least to
+    out.cpu_real_time_factor = float(result.sim_time / cpu) if cpu > 0 else float("nan")
+    out.tick_phases_cpu_ms = _tick_phases(rider, result.controller_cpu_times)
     if profile:
         profiler = PartProfiler(BUDGET_PARTS)
         profiled = _record(robot, board, out.scenario, seconds, wbc_solver, profiler)[0]
@@ -761,18 +770,26 @@ def _budget_table(rows: Sequence[PairBench]) -> list[str]:
     lines = [
         "",
         f"| pair | mean per control tick [ms]: loop | {head} | machine reference [ms] | "
-        "median tick [ms]: MPC / take-up / standby | other ticks' p99 [ms] |",
+        "median tick [ms]: MPC / take-up / standby | other ticks' p99 [ms] | "
+        "loop's CPU: real-time factor; median tick [ms] MPC / take-up / standby / other |",
     ]
-    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS) + "---|---|---|")
+    lines.append("|---|---|" + "---|" * len(BUDGET_PARTS) + "---|---|---|---|")
     for r in rows:
         b, phases = r.budget_ms, r.tick_phases_ms
         cells = " | ".join(_ms(b.get(k, float("nan"))) for k in ("loop", *BUDGET_PARTS))
-        periodic = " / ".join(
-            _ms(phases.get(f"{k}_median", float("nan"))) for k in ("mpc_tick", "take_up", "standby")
-        )
         steady = _ms(phases.get("steady_p99", float("nan")))
-        lines.append(f"| {r.pair} | {cells} | {_ms(r.reference_ms)} | {periodic} | {steady} |")
+        cpu = f"{r.cpu_real_time_factor:.2f}; {_periodic(r.tick_phases_cpu_ms, 'steady_median')}"
+        lines.append(
+            f"| {r.pair} | {cells} | {_ms(r.reference_ms)} | {_periodic(phases)} | {steady} | "
+            f"{cpu} |"
+        )
     return lines
+
+
+def _periodic(phases: dict[str, float], *more: str) -> str:
+    """The periodic ticks' medians [ms] (and ``more`` figures), ``/``-separated."""
+    keys = [f"{k}_median" for k in ("mpc_tick", "take_up", "standby")] + list(more)
+    return " / ".join(_ms(phases.get(k, float("nan"))) for k in keys)
 
 
 def _solver_table(what: str, rows: Sequence[tuple[str, dict[str, dict[str, Any]]]]) -> list[str]:

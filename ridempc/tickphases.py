@@ -30,10 +30,10 @@ def tick_phases(
     rate_hz: float,
     warmup: float,
 ) -> dict[str, float]:
-    """The controller ticks' wall times by phase of the MPC period (module docstring).
+    """The controller ticks' times by phase of the MPC period (module docstring).
 
     Args:
-        seconds: Each control tick's wall time [s], from the ride's first.
+        seconds: Each control tick's time [s] (wall or CPU), from the ride's first.
         period: Control ticks per MPC period.
         periodic: Phase of each periodic piece of work (``mpc_tick``, ``take_up``,
             ``standby``), None where it has no tick of its own.
@@ -42,8 +42,8 @@ def tick_phases(
 
     Returns:
         [ms] ``phase_<k>_median`` for each phase ``k`` of the period, ``<name>_median``
-        for each piece of work in ``periodic`` (NaN without a tick of its own) and
-        ``steady_p99``; NaN where the ride is too short to have them.
+        for each piece of work in ``periodic`` (NaN without a tick of its own),
+        ``steady_median`` and ``steady_p99``; NaN where the ride is too short to have them.
     """
     times = 1e3 * np.asarray(seconds, dtype=float)
     ticks = np.arange(times.size)
@@ -57,5 +57,6 @@ def tick_phases(
         out[f"{name}_median"] = out[f"phase_{at}_median"] if at is not None else float("nan")
     busy = [k for k in periodic.values() if k is not None]
     steady = times[kept & ~np.isin(phase, busy)]
+    out["steady_median"] = float(np.median(steady)) if steady.size else float("nan")
     out["steady_p99"] = float(np.percentile(steady, 99)) if steady.size else float("nan")
     return out

@@ -5,6 +5,8 @@ The benchmark itself (timings) is a command, not a test: ``ridempc bench --json 
 
 from __future__ import annotations
 
+import math
+
 import casadi
 import numpy as np
 import pytest
@@ -120,6 +122,9 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     assert all(p > 0.0 for p in parts), out.budget_ms
     assert sum(parts) == pytest.approx(out.budget_ms["loop"], rel=1e-9)
     assert out.budget_ms["loop"] == pytest.approx(2.0 / out.real_time_factor, rel=1e-6)
+    # the loop's own CPU time, what a loaded machine's other processes add least to
+    assert math.isfinite(out.cpu_real_time_factor) and out.cpu_real_time_factor > 0.0
+    assert "steady_median" in out.tick_phases_cpu_ms
     # the machine's speed of the moment, to compare benches made at different times
     assert 0.0 < out.reference_ms < 1e3  # [ms] a million additions
     from ridempc.bench import bench_table

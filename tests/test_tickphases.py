@@ -23,6 +23,7 @@ def test_the_periodic_ticks_are_named_and_left_out_of_the_steady_p99() -> None:
     assert math.isclose(figures["standby_median"], 2.0)
     assert math.isclose(figures["phase_5_median"], 0.5)
     assert math.isclose(figures["steady_p99"], 0.5)  # the periodic ticks and the warm-up out
+    assert math.isclose(figures["steady_median"], 0.5)
     # with the take-up in the MPC's tick (no latency), it has no tick of its own
     figures = tick_phases(seconds, period, {"mpc_tick": 0, "take_up": None}, rate, 1.0)
     assert math.isnan(figures["take_up_median"])

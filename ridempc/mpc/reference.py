@@ -27,6 +27,7 @@ keep every contact on the board. A missing, corrupt or inconsistent manifest or 
 from __future__ import annotations
 
 import re
+from bisect import bisect_right
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
@@ -52,6 +53,8 @@ __all__ = [
 
 Array = NDArray[np.float64]
 _FORCE = re.compile(r"^f_(.+)_([xyz])$")
+# [-] up to this many times, states_at goes row by row in floats: a tick reads one or two
+_FEW_TIMES: int = 4
 
 
 class ReferenceWindow(NamedTuple):
@@ -183,11 +186,37 @@ class MotionReference:
         (held before the start, ridden on steadily after the end): what the 500 Hz tick
         reads, without the inputs, contacts and parameters of a whole window."""
         times = np.asarray(times, dtype=np.float64)
+        if times.ndim == 1 and times.size <= _FEW_TIMES:
+            return self._few_states_at(times.tolist())
         states = _interp_rows(times, self.times, self.states)
         states += np.maximum(times - self.times[-1], 0.0)[:, None] * self.steady_rates
         if self.settle_states is not None:
             states += self._settled(times)[:, None] * self.settle_states
         return states
+
+    @cached_property
+    def _grid(self) -> list[float]:
+        """The node times as Python floats, for :meth:`_few_states_at`'s searches."""
+        return [float(t) for t in self.times]
+
+    def _few_states_at(self, times: list[float]) -> Array:
+        """:meth:`states_at` row by row in Python floats, the same arithmetic element for
+        element (so the same numbers to the bit): for the tick's one or two times, where
+        the arrays' searches, clips and broadcasts cost more than the interpolation."""
+        grid, states = self._grid, self.states
+        last, end = len(grid) - 1, grid[-1]
+        out = np.empty((len(times), states.shape[1]))
+        for k, t in enumerate(times):
+            upper = min(max(bisect_right(grid, t), 1), last)
+            lower = upper - 1
+            weight = min(max((t - grid[lower]) / (grid[upper] - grid[lower]), 0.0), 1.0)
+            row = (1.0 - weight) * states[lower] + weight * states[upper]
+            row += max(t - end, 0.0) * self.steady_rates
+            if self.settle_states is not None:
+                tau = min(max((t - end) / max(self.settle_time, 1e-9), 0.0), 1.0)
+                row += tau * tau * (3.0 - 2.0 * tau) * self.settle_states
+            out[k] = row
+        return out
 
     def _settled(self, times: Array) -> Array:
         """How far the settle has gone at ``times``: :math:`3\\tau^2 - 2\\tau^3`,

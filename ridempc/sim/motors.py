@@ -74,6 +74,16 @@ def delay_steps(delay: float, timestep: float) -> int:
     return max(0, math.ceil(delay / timestep - 1e-9))
 
 
+def _indexer(index: NDArray[np.int64]) -> NDArray[np.int64] | slice:
+    """``index`` as a slice where it is a run of consecutive entries (a quadruped's joints
+    and every robot's actuators: read and written as views, three times a control tick,
+    not gathered), else as it is."""
+    index = np.asarray(index, dtype=np.int64)
+    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
+
+
 class MotorDriver:
     """Applies the latest :class:`MotorCommand` at every physics step.
 
@@ -94,9 +104,9 @@ class MotorDriver:
         self, model: mujoco.MjModel, motors: tuple[Motor, ...], actuator_ids: NDArray[np.int64]
     ) -> None:
         joint_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, m.joint) for m in motors]
-        self._qpos = np.array([model.jnt_qposadr[j] for j in joint_ids])
-        self._dof = np.array([model.jnt_dofadr[j] for j in joint_ids])
-        self._actuators = actuator_ids
+        self._qpos = _indexer(np.array([model.jnt_qposadr[j] for j in joint_ids]))
+        self._dof = _indexer(np.array([model.jnt_dofadr[j] for j in joint_ids]))
+        self._actuators = _indexer(np.asarray(actuator_ids))
         self._gear = np.array([m.gear for m in motors])
         self.curve = TorqueSpeedCurve.of(motors)
         step = float(model.opt.timestep)

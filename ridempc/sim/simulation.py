@@ -60,6 +60,10 @@ class RunResult:
         error: Why the run failed, or None.
         log: Time series at the logging rate.
         controller_times: Wall time of each controller update [s].
+        controller_cpu_times: CPU time of the loop's thread in each controller update [s]
+            (``time.thread_time``: what a loaded machine's other processes do not add to,
+            nor a wait for the MPC's solver thread or process).
+        cpu_time: CPU time of the loop's thread over the loop [s].
     """
 
     status: str
@@ -70,6 +74,8 @@ class RunResult:
     error: str | None = None
     log: dict[str, Array] = field(default_factory=dict)
     controller_times: Array = field(default_factory=lambda: np.zeros(0))
+    controller_cpu_times: Array = field(default_factory=lambda: np.zeros(0))
+    cpu_time: float = 0.0
 
     @property
     def fell(self) -> bool:
@@ -254,15 +260,15 @@ class Simulation:
         if speed > MAX_SPEED:
             raise SimulationDiverged(t, f"a velocity reached {speed:.3g} (limit {MAX_SPEED})")
 
-    def _control(self, tick: int, t: float, data: mujoco.MjData) -> float:
-        """One controller tick; returns its wall time [s]."""
+    def _control(self, tick: int, t: float, data: mujoco.MjData) -> tuple[float, float]:
+        """One controller tick; returns its wall time and its thread's CPU time [s]."""
         assert self.sensors is not None and self.driver is not None and self.controller
         packet = self.sensors.read(tick, data)
         if tick == 0:
             self.controller.reset(packet)
-        began = time.perf_counter()
+        began, began_cpu = time.perf_counter(), time.thread_time()
         command = self.controller.update(packet, self.scenario.command_at(t))
-        elapsed = time.perf_counter() - began
+        elapsed = time.perf_counter() - began, time.thread_time() - began_cpu
         if not command.is_finite():
             raise SimulationDiverged(t, "the controller returned a non-finite command")
         self.driver.command = command
@@ -278,11 +284,11 @@ class Simulation:
         hz = scene.physics_hz
         n_ticks = round(self.scenario.duration * hz)
         recorder = Recorder()
-        times: list[float] = []
+        times: list[tuple[float, float]] = []  # each controller update's wall and CPU time
         result = RunResult(status="ok", sim_time=0.0, wall_time=0.0)
         tick = 0
         with frozen_heap():  # the models and the library stay out of the collector's walks
-            start = time.perf_counter()
+            start, start_cpu = time.perf_counter(), time.thread_time()
             try:
                 self.changes.apply(0, data)  # before the first step: a heavier rider starts so
                 for tick in range(n_ticks + 1):
@@ -319,6 +325,9 @@ class Simulation:
                     self.controller.close()
         result.sim_time = tick / hz
         result.wall_time = time.perf_counter() - start
+        result.cpu_time = time.thread_time() - start_cpu
         result.log = recorder.arrays()
-        result.controller_times = np.array(times)
+        spent = np.array(times).reshape(-1, 2)
+        result.controller_times = spent[:, 0].copy()
+        result.controller_cpu_times = spent[:, 1].copy()
         return result

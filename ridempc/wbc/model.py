@@ -281,10 +281,12 @@ class WholeBodyModel:
             np.array(data.acom[0]),
         )
         frames = self._frames
-        placements = [data.oMf[frame] for frame in frames]
-        positions = np.array([placement.translation for placement in placements])
-        # orientations of the base and the sites only (the anchors' are not read)
-        rotations = np.array([p.rotation for p in placements[: self._site_rows.stop]])
+        # each frame's placement as one 4 x 4 (one call a frame, not two): its translation
+        # and, for the base and the sites (the anchors' are not read), its rotation, copied
+        # contiguous so that the products that follow add up as on their own arrays
+        placements = np.array([data.oMf[frame].homogeneous for frame in frames])
+        positions = np.ascontiguousarray(placements[:, :3, 3])
+        rotations = np.ascontiguousarray(placements[: self._site_rows.stop, :3, :3])
         jacobians = np.array(
             [pin.getFrameJacobian(model, data, frame, WORLD_ALIGNED)[:3] for frame in frames]
         )
