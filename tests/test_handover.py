@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ridempc.mpc.handover import BLEND_S, Handover, blend, deviation
+from ridempc.mpc.handover import BLEND_S, Handover, blend, deviation, standby_every
 from ridempc.sim.motors import MotorCommand
 
 DT = 0.002  # [s] the rider's tick
@@ -100,6 +100,46 @@ def test_in_standby_the_backup_runs_on_its_first_tick_then_every_nth() -> None:
     assert backup.ticks == 1 + 3  # tick 0, then 7, 22 and 37
     _run(handover, 20, 45, range(50, 51))  # from the failure on, every tick
     assert backup.ticks == 4 + 15  # none in standby at 45-49, then every tick of 50-64
+
+
+class _Timer:
+    """A backup with time-based logic, as a law's own: how long a flag (a foot unloaded) has
+    been on, stepped by the sample times, as :class:`CassieHovershoes` counts a foot's."""
+
+    def __init__(self) -> None:
+        self.on_for = 0.0
+        self.flag = False
+        self._time: float | None = None
+
+    def update(self, sensors: Any, command: Any) -> MotorCommand:
+        step = 0.0 if self._time is None else sensors.time - self._time
+        self._time = sensors.time
+        self.on_for = self.on_for + step if self.flag else 0.0
+        return _command(1.0)
+
+
+def _timer_at_handover(settled_every: int, unsettled_from: int) -> float:
+    """The time the flag is counted on when the ride is handed over, the flag on from tick
+    100 and the handover at tick 110, the rider unsettled from ``unsettled_from``."""
+    backup = _Timer()
+    handover = Handover(backup, standby_every=settled_every)  # type: ignore[arg-type]
+    for k in range(111):
+        backup.flag = k >= 100
+        handover.standby_every = standby_every(settled_every, False, settled=k < unsettled_from)
+        failure = "test" if k == 110 else None
+        handover.step(SimpleNamespace(time=k * DT), None, _command(0.0), failure, True)  # type: ignore[arg-type]
+    return backup.on_for
+
+
+def test_the_standby_runs_every_tick_while_the_rider_is_unsettled() -> None:
+    assert standby_every(15, warming=False, settled=True) == 15
+    assert standby_every(15, warming=True, settled=True) == 1
+    assert standby_every(15, warming=False, settled=False) == 1
+    # sampled every tick from the rider's unsettling on, the backup takes the ride with the
+    # flag counted as in its own ride (each of ticks 100-110 its step); every 15th tick
+    # alone, the sample before the flag's (tick 97) counts it on since then
+    assert _timer_at_handover(15, unsettled_from=90) == pytest.approx(11 * DT)
+    assert _timer_at_handover(15, unsettled_from=200) == pytest.approx(13 * DT)
 
 
 class _Estimator:

@@ -18,7 +18,13 @@ start, as when it rides alone.
 The standby would cost the backup's whole tick at every tick. Most of that is its state
 estimator, the same filter on the same sensors as the primary's where both see the same
 platforms: there it reads the primary's estimate instead (:func:`share_estimator`), and
-runs in standby only every :data:`STANDBY_DIVIDER` ticks.
+runs in standby only every :data:`STANDBY_DIVIDER` ticks while the primary holds the rider
+settled. Sampled that sparsely, the backup's time-based logic credits a step of the state
+to the whole interval since its last sample (a foot read unloaded once counts as unloaded
+for 30 ms, and a leg reaches down after a shoe that never fell); a backup handed the ride
+then commands its own state, not the rider's. So while the rider is off its reference
+(beyond the return band, where a handover may follow) it runs every tick, as in its own
+ride (:func:`standby_every`).
 
 A ride may also *start* on the backup (:meth:`Handover.start_on_backup`): the primary then
 takes the ride, blended in as on a return, the first tick it is *ready*
@@ -56,6 +62,7 @@ __all__ = [
     "blend",
     "deviation",
     "share_estimator",
+    "standby_every",
 ]
 
 # [s] the blend of the two laws' commands: 10 ticks at 500 Hz, so no field of the command
@@ -256,6 +263,14 @@ class Handover:
     def summary(self) -> list[dict[str, Any]]:
         """Every handover, for ``summary.json``'s ``fallbacks``."""
         return [f.record() for f in self.fallbacks]
+
+
+def standby_every(divider: int, warming: bool, settled: bool) -> int:
+    """How often the backup runs in standby [ticks]: every tick while it is ``warming`` (its
+    filters settling from rest) or the primary's rider is not ``settled`` (its deviation
+    beyond :data:`RETURN_DEVIATION`: a handover may come, and the backup must take it with
+    the state it would have in its own ride), else every ``divider`` ticks."""
+    return 1 if warming or not settled else divider
 
 
 def deviation(
