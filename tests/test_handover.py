@@ -9,7 +9,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ridempc.mpc.handover import BLEND_S, Handover, blend, deviation, standby_every
+from ridempc.mpc.handover import (
+    BLEND_S,
+    POSTURE_FADE_S,
+    Handover,
+    blend,
+    deviation,
+    standby_every,
+)
 from ridempc.sim.motors import MotorCommand
 
 DT = 0.002  # [s] the rider's tick
@@ -33,7 +40,7 @@ class _Backup:
 def _run(handover: Handover, ticks: int, start: int, fails: range, fit: bool = True) -> list:
     sent = []
     for k in range(start, start + ticks):
-        sensors = SimpleNamespace(time=k * DT)
+        sensors = SimpleNamespace(time=k * DT, joint_position=np.ones(3))
         failure = "WbcFailed: test" if k in fails else None
         sent.append(handover.step(sensors, None, _command(0.0), failure, fit))  # type: ignore[arg-type]
     return sent
@@ -127,7 +134,8 @@ def _timer_at_handover(settled_every: int, unsettled_from: int) -> float:
         backup.flag = k >= 100
         handover.standby_every = standby_every(settled_every, False, settled=k < unsettled_from)
         failure = "test" if k == 110 else None
-        handover.step(SimpleNamespace(time=k * DT), None, _command(0.0), failure, True)  # type: ignore[arg-type]
+        sensors = SimpleNamespace(time=k * DT, joint_position=np.ones(3))
+        handover.step(sensors, None, _command(0.0), failure, True)  # type: ignore[arg-type]
     return backup.on_for
 
 
@@ -140,6 +148,31 @@ def test_the_standby_runs_every_tick_while_the_rider_is_unsettled() -> None:
     # alone, the sample before the flag's (tick 97) counts it on since then
     assert _timer_at_handover(15, unsettled_from=90) == pytest.approx(11 * DT)
     assert _timer_at_handover(15, unsettled_from=200) == pytest.approx(13 * DT)
+
+
+class _Posture:
+    """A backup holding its posture target, 1 rad, plus a step of 0.1 rad from tick 300."""
+
+    def update(self, sensors: Any, command: Any) -> MotorCommand:
+        target = 1.0 + (0.1 if sensors.time >= 300 * DT - 1e-9 else 0.0)
+        return MotorCommand(np.zeros(3), np.full(3, target), np.zeros(3), np.ones(3), np.ones(3))
+
+
+def test_a_handover_fades_the_posture_offset_and_passes_the_feedback_at_once() -> None:
+    handover = Handover(_Posture(), blend_s=0.0)  # type: ignore[arg-type]
+    targets = []
+    for k in range(100, 700):
+        joints = np.full(3, 0.6)  # the primary's posture: 0.4 rad off the backup's
+        sensors = SimpleNamespace(time=k * DT, joint_position=joints)
+        failure = "test" if k == 100 else None
+        sent = handover.step(sensors, None, _command(0.0), failure, False)  # type: ignore[arg-type]
+        targets.append(sent.position[0])
+    half = round(POSTURE_FADE_S / DT / 2)
+    assert targets[0] == pytest.approx(0.6)  # no step of the target at the handover
+    assert targets[half] == pytest.approx(0.8)  # half the offset gone half-way
+    # the backup's step at tick 300 passes whole, on top of what remains of the offset
+    assert targets[200] - targets[199] == pytest.approx(0.1, abs=2e-3)
+    assert targets[-1] == pytest.approx(1.1)  # then the backup's own target
 
 
 class _Estimator:
