@@ -9,7 +9,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ridempc.mpc.handover import BLEND_S, Handover, blend, deviation
+from ridempc.mpc.handover import (
+    BLEND_S,
+    POSTURE_FADE_S,
+    Handover,
+    blend,
+    deviation,
+    standby_every,
+)
 from ridempc.sim.motors import MotorCommand
 
 DT = 0.002  # [s] the rider's tick
@@ -33,7 +40,7 @@ class _Backup:
 def _run(handover: Handover, ticks: int, start: int, fails: range, fit: bool = True) -> list:
     sent = []
     for k in range(start, start + ticks):
-        sensors = SimpleNamespace(time=k * DT)
+        sensors = SimpleNamespace(time=k * DT, joint_position=np.ones(3))
         failure = "WbcFailed: test" if k in fails else None
         sent.append(handover.step(sensors, None, _command(0.0), failure, fit))  # type: ignore[arg-type]
     return sent
@@ -100,6 +107,72 @@ def test_in_standby_the_backup_runs_on_its_first_tick_then_every_nth() -> None:
     assert backup.ticks == 1 + 3  # tick 0, then 7, 22 and 37
     _run(handover, 20, 45, range(50, 51))  # from the failure on, every tick
     assert backup.ticks == 4 + 15  # none in standby at 45-49, then every tick of 50-64
+
+
+class _Timer:
+    """A backup with time-based logic, as a law's own: how long a flag (a foot unloaded) has
+    been on, stepped by the sample times, as :class:`CassieHovershoes` counts a foot's."""
+
+    def __init__(self) -> None:
+        self.on_for = 0.0
+        self.flag = False
+        self._time: float | None = None
+
+    def update(self, sensors: Any, command: Any) -> MotorCommand:
+        step = 0.0 if self._time is None else sensors.time - self._time
+        self._time = sensors.time
+        self.on_for = self.on_for + step if self.flag else 0.0
+        return _command(1.0)
+
+
+def _timer_at_handover(settled_every: int, unsettled_from: int) -> float:
+    """The time the flag is counted on when the ride is handed over, the flag on from tick
+    100 and the handover at tick 110, the rider unsettled from ``unsettled_from``."""
+    backup = _Timer()
+    handover = Handover(backup, standby_every=settled_every)  # type: ignore[arg-type]
+    for k in range(111):
+        backup.flag = k >= 100
+        handover.standby_every = standby_every(settled_every, False, settled=k < unsettled_from)
+        failure = "test" if k == 110 else None
+        sensors = SimpleNamespace(time=k * DT, joint_position=np.ones(3))
+        handover.step(sensors, None, _command(0.0), failure, True)  # type: ignore[arg-type]
+    return backup.on_for
+
+
+def test_the_standby_runs_every_tick_while_the_rider_is_unsettled() -> None:
+    assert standby_every(15, warming=False, settled=True) == 15
+    assert standby_every(15, warming=True, settled=True) == 1
+    assert standby_every(15, warming=False, settled=False) == 1
+    # sampled every tick from the rider's unsettling on, the backup takes the ride with the
+    # flag counted as in its own ride (each of ticks 100-110 its step); every 15th tick
+    # alone, the sample before the flag's (tick 97) counts it on since then
+    assert _timer_at_handover(15, unsettled_from=90) == pytest.approx(11 * DT)
+    assert _timer_at_handover(15, unsettled_from=200) == pytest.approx(13 * DT)
+
+
+class _Posture:
+    """A backup holding its posture target, 1 rad, plus a step of 0.1 rad from tick 300."""
+
+    def update(self, sensors: Any, command: Any) -> MotorCommand:
+        target = 1.0 + (0.1 if sensors.time >= 300 * DT - 1e-9 else 0.0)
+        return MotorCommand(np.zeros(3), np.full(3, target), np.zeros(3), np.ones(3), np.ones(3))
+
+
+def test_a_handover_fades_the_posture_offset_and_passes_the_feedback_at_once() -> None:
+    handover = Handover(_Posture(), blend_s=0.0)  # type: ignore[arg-type]
+    targets = []
+    for k in range(100, 700):
+        joints = np.full(3, 0.6)  # the primary's posture: 0.4 rad off the backup's
+        sensors = SimpleNamespace(time=k * DT, joint_position=joints)
+        failure = "test" if k == 100 else None
+        sent = handover.step(sensors, None, _command(0.0), failure, False)  # type: ignore[arg-type]
+        targets.append(sent.position[0])
+    half = round(POSTURE_FADE_S / DT / 2)
+    assert targets[0] == pytest.approx(0.6)  # no step of the target at the handover
+    assert targets[half] == pytest.approx(0.8)  # half the offset gone half-way
+    # the backup's step at tick 300 passes whole, on top of what remains of the offset
+    assert targets[200] - targets[199] == pytest.approx(0.1, abs=2e-3)
+    assert targets[-1] == pytest.approx(1.1)  # then the backup's own target
 
 
 class _Estimator:

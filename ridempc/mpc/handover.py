@@ -10,7 +10,18 @@ each further handover, :meth:`Handover.dwell`):
 .. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
           \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
 
-over every field of the motor command (feedforward torque, targets and gains). The backup
+over every field of the motor command (feedforward torque, targets and gains). A backup
+handed a rider in another posture than its own (the MPC twists the pelvis over the feet, or
+crouches) would pull every joint to its posture at once, its stiffness times the posture's
+error (0.25 rad of hip yaw at 300 N m/rad: 75 N m, which turns the shoes under the rider);
+so, bumpless, the offset between the joints and the backup's position targets at the
+handover is laid over those targets and fades out (:class:`PostureFade`), while every
+change of the targets after it (the backup's feedback) passes at once:
+
+.. math:: q^{des}(t) = q^{des}_{to}(t) + (1 - w(t))\\,(q(t_{switch}) - q^{des}_{to}(t_{switch})),
+          \\qquad w(t) = \\tfrac12 \\big(1 - \\cos(\\pi \\min(1, (t - t_{switch}) / T_{fade}))\\big)
+
+The backup
 runs beside the primary (hot standby): its estimator, filters and integrators are current
 at the moment it takes over, and its nominal posture is the one it took at the ride's
 start, as when it rides alone.
@@ -18,7 +29,13 @@ start, as when it rides alone.
 The standby would cost the backup's whole tick at every tick. Most of that is its state
 estimator, the same filter on the same sensors as the primary's where both see the same
 platforms: there it reads the primary's estimate instead (:func:`share_estimator`), and
-runs in standby only every :data:`STANDBY_DIVIDER` ticks.
+runs in standby only every :data:`STANDBY_DIVIDER` ticks while the primary holds the rider
+settled. Sampled that sparsely, the backup's time-based logic credits a step of the state
+to the whole interval since its last sample (a foot read unloaded once counts as unloaded
+for 30 ms, and a leg reaches down after a shoe that never fell); a backup handed the ride
+then commands its own state, not the rider's. So while the rider is off its reference
+(beyond the return band, where a handover may follow) it runs every tick, as in its own
+ride (:func:`standby_every`).
 
 A ride may also *start* on the backup (:meth:`Handover.start_on_backup`): the primary then
 takes the ride, blended in as on a return, the first tick it is *ready*
@@ -32,6 +49,8 @@ command (or None), why it failed (or None) and whether it is fit to ride.
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -51,11 +70,14 @@ __all__ = [
     "RETURN_DWELL_S",
     "STANDBY_DIVIDER",
     "Fallback",
+    "POSTURE_FADE_S",
     "Handover",
+    "PostureFade",
     "SharedEstimate",
     "blend",
     "deviation",
     "share_estimator",
+    "standby_every",
 ]
 
 # [s] the blend of the two laws' commands: 10 ticks at 500 Hz, so no field of the command
@@ -63,6 +85,10 @@ __all__ = [
 # command is out within 20 ms (0.1 and 0.3 s changed nothing on the ride tried, Segway
 # stand-still seed 6).
 BLEND_S: float = 0.02
+# [s] the fade of the posture's offset at a handover (PostureFade): a rider's divergence
+# time and a half (Cassie's 1/omega = 0.3 s), so that the backup's posture comes back slower
+# than the lean it balances grows, and its feedback, not the posture, sets the first steps
+POSTURE_FADE_S: float = 0.5
 # [s] how long the primary must be fit before it rides again, the hysteresis in time: 15
 # MPC solves in a row near the reference, so that one good solve in a fall, or a rider at
 # the edge of the primary's region, does not hand the ride back and forth.
@@ -104,6 +130,32 @@ class Fallback:
         return {"time_s": self.time_s, "reason": self.reason, "duration_s": self.duration_s}
 
 
+class PostureFade:
+    """The offset between the joints and a law's position targets at a switch, fading out
+    over ``duration`` [s] from ``start`` [s] (the module's :math:`q^{des}(t)`).
+
+    Args:
+        start: The switch's time [s].
+        offset: :math:`q(t_{switch}) - q^{des}_{to}(t_{switch})` per motor [rad].
+        duration: :math:`T_{fade}` [s].
+    """
+
+    def __init__(self, start: float, offset: NDArray[np.float64], duration: float) -> None:
+        self.start = start
+        self.offset = offset
+        self.duration = duration
+
+    def done(self, now: float) -> bool:
+        return now - self.start >= self.duration - TIME_TOLERANCE
+
+    def __call__(self, now: float, command: MotorCommand) -> MotorCommand:
+        """``command`` with what remains of the offset at ``now`` [s] on its targets."""
+        if self.done(now):
+            return command
+        remaining = 0.5 * (1.0 + math.cos(math.pi * max(now - self.start, 0.0) / self.duration))
+        return dataclasses.replace(command, position=command.position + remaining * self.offset)
+
+
 def blend(start: MotorCommand, end: MotorCommand, alpha: float) -> MotorCommand:
     """:math:`(1 - \\alpha)\\, start + \\alpha\\, end`, field by field."""
     if alpha >= 1.0:
@@ -130,6 +182,7 @@ class Handover:
             the first, off the ticks a primary with a slower loop of its own starts from.
         standby_phase: The tick of each ``standby_every`` the standby runs on (None: half
             a period, ``standby_every // 2``; :func:`~ridempc.mpc.stagger.standby_phase`).
+        fade_s: :math:`T_{fade}` [s] (0: none).
 
     Attributes:
         fallbacks: Every handover so far, in order.
@@ -142,8 +195,11 @@ class Handover:
         dwell_s: float = RETURN_DWELL_S,
         standby_every: int = 1,
         standby_phase: int | None = None,
+        fade_s: float = POSTURE_FADE_S,
     ) -> None:
         self.backup = backup
+        self.fade_s = fade_s
+        self._fade: PostureFade | None = None  # the posture's offset at the last handover
         self.standby_every = standby_every
         self.standby_phase = standby_every // 2 if standby_phase is None else standby_phase
         self._ticks = 0
@@ -210,18 +266,22 @@ class Handover:
             self.fallbacks.append(Fallback(now, failure or "no command"))
             self._switch(now, start if start is not None else backup)
             self._fit_since = None
-            return self._blended(now, backup)
+            if self.fade_s > 0.0:
+                joints = np.asarray(sensors.joint_position[: len(backup.position)], dtype=float)
+                self._fade = PostureFade(now, joints - backup.position, self.fade_s)
+            return self._blended(now, self._faded(now, backup))
         if failure is None and primary is not None and fit:
             self._fit_since = now if self._fit_since is None else self._fit_since
             if now - self._fit_since >= self.dwell() - TIME_TOLERANCE:
                 current = self.fallbacks[-1]
                 current.duration_s = now - current.time_s
-                self._switch(now, self._blended(now, backup))
+                self._switch(now, self._blended(now, self._faded(now, backup)))
+                self._fade = None
                 self._last_primary = primary
                 return self._blended(now, primary)
         else:
             self._fit_since = None
-        return self._blended(now, backup)
+        return self._blended(now, self._faded(now, backup))
 
     def _backup(self, sensors: SensorPacket, command: Command, needed: bool) -> MotorCommand:
         """The backup's command: run this tick where it rides, is blended or ``needed``, on
@@ -238,6 +298,15 @@ class Handover:
         ):
             self._backup_command = self.backup.update(sensors, command)
         return self._backup_command
+
+    def _faded(self, now: float, command: MotorCommand) -> MotorCommand:
+        """The backup's ``command`` with the posture's offset at the handover, fading."""
+        if self._fade is None:
+            return command
+        if self._fade.done(now):
+            self._fade = None
+            return command
+        return self._fade(now, command)
 
     def _switch(self, now: float, start: MotorCommand) -> None:
         self._switch_time, self._from = now, start
@@ -256,6 +325,14 @@ class Handover:
     def summary(self) -> list[dict[str, Any]]:
         """Every handover, for ``summary.json``'s ``fallbacks``."""
         return [f.record() for f in self.fallbacks]
+
+
+def standby_every(divider: int, warming: bool, settled: bool) -> int:
+    """How often the backup runs in standby [ticks]: every tick while it is ``warming`` (its
+    filters settling from rest) or the primary's rider is not ``settled`` (its deviation
+    beyond :data:`RETURN_DEVIATION`: a handover may come, and the backup must take it with
+    the state it would have in its own ride), else every ``divider`` ticks."""
+    return 1 if warming or not settled else divider
 
 
 def deviation(

@@ -94,6 +94,7 @@ from ridempc.mpc.handover import (
     Handover,
     deviation,
     share_estimator,
+    standby_every,
 )
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -750,7 +751,8 @@ class MpcRider(Controller):
             commanded = self.manoeuvre.kind not in (HOLD, "stop")
             self.readiness.update(solve.time, settling, in_band, commanded)
         warming = not self._probation.proven and solve.time < STANDBY_WARMUP_S
-        self.handover.standby_every = 1 if warming else self._standby_every
+        in_return_band = max(built.deviation, self._divergence.value) <= RETURN_DEVIATION
+        self.handover.standby_every = standby_every(self._standby_every, warming, in_return_band)
         self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
         self._mpc_qp_ms.append(1e3 * plan.solve_time)
         if not np.all(np.isfinite(plan.states)):
