@@ -159,6 +159,7 @@ def test_a_rider_with_the_stage_estimates_while_it_balances() -> None:
     bound, and the rider stands."""
     from ridempc.boards import load_board
     from ridempc.mpc.rider import MpcRider
+    from ridempc.mpc.stages.drifts import disturbance_observer
     from ridempc.pair_description import DisturbanceStage
     from ridempc.robots import load_robot
     from ridempc.scenarios import resolve_scenario
@@ -174,7 +175,8 @@ def test_a_rider_with_the_stage_estimates_while_it_balances() -> None:
     description = rider.pair.description
     stages = description.stages.model_copy(update={"disturbance": stage})
     rider.pair = rider.pair._replace(description=description.model_copy(update={"stages": stages}))
-    rider.disturbance = rider._disturbance_observer()
+    rider.disturbance = disturbance_observer(rider.pair, rider.mpc.reference.state_names)
+    rider.drifts = rider._drift_sources()  # the stage list built again with it
     assert rider.disturbance is not None
     assert rider.disturbance.rows == (rider.mpc.reference.state_names.index("vz"),)
     scenario = resolve_scenario("stand-still", "skateboard").with_duration(0.3)

@@ -210,16 +210,16 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     times = now + lead + problem.dt * np.arange(problem.state_reference.shape[0])
     wanted = np.array([scenario.command_at(float(t)).roll for t in times])
     assert np.ptp(wanted) > 0.05  # the command moves over the horizon
-    roll = rider._roll_horizon(scenario.command_at(now), now)
+    roll = rider.commands.roll_horizon(scenario.command_at(now), now)
     np.testing.assert_allclose(roll, wanted)
     # the deck's roll steers the board (eq. 14): the turn it makes at 0.5 m/s, none at rest
-    gain = rider._steer_gain
+    gain = rider.commands.steer_gain
     assert gain == load_board("skateboard").params.reduced.steer_gain  # identified [1/m]
     steps = mpc.settings.horizon
-    turn = rider._roll_turn(roll, 0.5)
+    turn = rider.commands.roll_turn(roll, 0.5, names)
     np.testing.assert_allclose(turn, -gain * 0.5 * np.sin(wanted[:steps]))
-    assert not rider._roll_turn(roll, 0.0).any()
-    assert not rider._roll_turn(np.zeros_like(roll), 0.5).any()
+    assert not rider.commands.roll_turn(roll, 0.0, names).any()
+    assert not rider.commands.roll_turn(np.zeros_like(roll), 0.5, names).any()
     laid = rider.selector.with_command(problem, names, roll)
     np.testing.assert_allclose(laid.state_reference[:, names["board_roll"]], wanted)
     np.testing.assert_allclose(
@@ -227,8 +227,8 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     )
     rider.command_preview = None
     step = 1.0 / 30.0
-    rider._roll_horizon(scenario.command_at(now - step), now - step)
-    blind = rider._roll_horizon(scenario.command_at(now), now)
+    rider.commands.roll_horizon(scenario.command_at(now - step), now - step)
+    blind = rider.commands.roll_horizon(scenario.command_at(now), now)
     assert blind[0] == pytest.approx(wanted[0], abs=1e-3)  # extrapolated over the lead
     assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend
 
@@ -388,8 +388,8 @@ def test_push_off_1_0_seed_5_rides_its_roll_wave_within_the_stance_limit(dog) ->
     result = Simulation(scene, rider, scenario, seed=5).run()
     assert result.status == "ok", result.fall_reason
     assert not result.fell and rider.summary().get("safe_hold") is None
-    assert rider.stance is not None and rider.stance.last is not None
-    low, high = rider.stance.last
+    assert rider.stance_roll is not None and rider.stance_roll.limit.last is not None
+    low, high = rider.stance_roll.limit.last
     assert low < -0.1 and high > 0.1  # a normal stance holds the whole wave
     metrics = run_metrics(result, scenario, dog)
     assert metrics["roll_rmse"] < 0.02
@@ -429,15 +429,15 @@ def test_the_cassie_riders_read_a_planned_speed_over_their_horizon(dog) -> None:
     assert horizon == pytest.approx(0.4)
     now = scenario.command_at(2.7)
     assert now.velocity == 0.0
-    assert shoes._speed_command(now, 2.7).velocity == 0.0  # no plan given yet
+    assert shoes.commands.speed_command(now, 2.7).velocity == 0.0  # no plan given yet
     for rider in (shoes, segway, skate):
         rider.command_preview = scenario.command_at
-    assert shoes._speed_command(now, 2.7).velocity == 0.5
-    assert segway._speed_command(now, 2.7).velocity == 0.5
-    ahead = shoes._speed_command(now, 2.7)
+    assert shoes.commands.speed_command(now, 2.7).velocity == 0.5
+    assert segway.commands.speed_command(now, 2.7).velocity == 0.5
+    ahead = shoes.commands.speed_command(now, 2.7)
     assert ahead.yaw_rate == now.yaw_rate  # only the speed is read ahead
-    assert shoes._speed_command(scenario.command_at(2.55), 2.55).velocity == 0.0
-    assert skate._speed_command(now, 2.7).velocity == 0.0  # the skateboard does not preview
+    assert shoes.commands.speed_command(scenario.command_at(2.55), 2.55).velocity == 0.0
+    assert skate.commands.speed_command(now, 2.7).velocity == 0.0  # the skateboard does not preview
     assert shoes.summary()["speed_preview_s"] == pytest.approx(0.4)  # the summary says so
     assert skate.summary()["speed_preview_s"] == 0.0
 
@@ -558,10 +558,10 @@ def test_headings_are_unwrapped_to_the_turn_so_far(dog) -> None:
     headings = [i for n, i in names.items() if n.endswith(("_yaw", "_psi"))]
     assert headings
     reference = rider.mpc.reference.states_at(np.array([0.0]))[0]
-    rider._turned = 3.0  # [rad] turned so far
+    rider.turn.turned = 3.0  # [rad] turned so far
     x0 = rider.map.state(estimate)
     x0[headings] = reference[headings] + 3.1 - 2.0 * np.pi  # as the estimate wraps it
-    out = rider._unwrapped(x0, reference)
+    out = rider.turn.unwrapped(x0, reference, rider.layout.headings)
     np.testing.assert_allclose(out[headings], reference[headings] + 3.1, atol=1e-12)
     others = [i for i in range(len(x0)) if i not in headings]
     np.testing.assert_array_equal(out[others], x0[others])

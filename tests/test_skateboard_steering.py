@@ -104,9 +104,9 @@ def test_the_mpc_rider_steers_a_planned_yaw_rate_by_the_deck_roll() -> None:
     times = now + lead + settings.dt * np.arange(settings.horizon + 1)
     wanted = np.array([scenario.command_at(float(t)).yaw_rate for t in times])
     assert wanted[0] == 0.2 and wanted[-1] < -0.15  # ramped over 0.4 s from 7.7 s
-    roll = rider._steering_roll(scenario.command_at(now), now, speed)
-    assert rider.roll_steering is not None
-    np.testing.assert_allclose(yaw_rate(speed, roll, rider.roll_steering.gain), wanted)
-    turn = rider._roll_turn(roll, speed)
+    roll = rider.commands.steering_roll(scenario.command_at(now), now, speed)
+    assert rider.commands.roll_steering is not None
+    np.testing.assert_allclose(yaw_rate(speed, roll, rider.commands.roll_steering.gain), wanted)
+    turn = rider.commands.roll_turn(roll, speed, rider.layout.names)
     np.testing.assert_allclose(turn, wanted[: settings.horizon])
-    assert not rider._steering_roll(scenario.command_at(now), now, 0.1).any()
+    assert not rider.commands.steering_roll(scenario.command_at(now), now, 0.1).any()
