@@ -185,3 +185,34 @@ def test_tracks_the_deck_roll_reference(dog) -> None:
     # rings the deck for a second; the bound leaves room for other platforms' arithmetic
     assert metrics["roll_rmse"] < 0.025
     assert metrics["board_max_tilt"] < 0.15
+
+
+class _WithStandby(QuadrupedSkateboardPD):
+    """The PD riding, and a twin fed the same packets only every :data:`STANDBY` ticks, as
+    a backup in standby is."""
+
+    STANDBY = 15  # [ticks] the handover's standby divider
+
+    def __init__(self, robot, board: str) -> None:
+        super().__init__(robot, board)
+        self.twin = QuadrupedSkateboardPD(robot, board)
+        self.ticks = 0
+
+    def update(self, sensors, command):
+        if self.ticks % self.STANDBY == 0:
+            self.twin.update(sensors, command)
+        self.ticks += 1
+        return super().update(sensors, command)
+
+
+def test_a_backup_in_standby_keeps_the_rides_time(dog) -> None:
+    """Updated every 15th tick, the lateral shift's filters still follow the deck's roll
+    reference in time: the twin's shift is the riding PD's, not 15 times slower."""
+    scenario = resolve_scenario("roll-tracking", "skateboard").with_duration(2.8)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    controller = _WithStandby(dog, "skateboard")
+    result = Simulation(scene, controller, scenario).run()
+    assert result.status == "ok", result.fall_reason or result.error
+    riding, standby = controller._shift[0], controller.twin._shift[0]
+    assert abs(riding) > 0.005  # [m] the wave has moved the centre of mass
+    assert standby == pytest.approx(riding, rel=0.25)

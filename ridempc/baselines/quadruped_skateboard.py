@@ -256,6 +256,7 @@ class QuadrupedSkateboardPD(Controller):
         self._stance = np.zeros((4, 2))  # [m] the feet's (x, y) about their centroid
         self._relative_yaw = 0.0  # [rad] trunk yaw in F
         self._previous: tuple[float, float, float] | None = None  # time, roll ref, its rate
+        self._last_update: float | None = None  # [s] the packet time of the last shift update
         self._roll_rate = 0.0  # [rad/s] filtered
         self._roll_integral = 0.0  # [m]
         self._feedback = (0.0, 0.0)  # filtered feedback shift [m], [m/s]
@@ -324,6 +325,7 @@ class QuadrupedSkateboardPD(Controller):
         rotation = state.trunk_rotation
         self._relative_yaw = math.atan2(rotation[1, 0], rotation[0, 0])
         self._previous = None
+        self._last_update = None
         self._roll_rate = 0.0
         self._roll_integral = 0.0
         self._feedback = (0.0, 0.0)
@@ -353,6 +355,14 @@ class QuadrupedSkateboardPD(Controller):
         self._previous = (sensors.time, roll, rate)
         return roll, rate, acceleration
 
+    def _step(self, time: float) -> float:
+        """The time the filters advance by [s]: the control ticks since the last update, at
+        least one. A backup in standby is updated every few ticks only, and its filters must
+        keep the ride's time, or it is handed a shift that lags the deck by as many periods."""
+        last, self._last_update = self._last_update, time
+        ticks = 1 if last is None else max(1, round((time - last) * self.rate_hz))
+        return ticks / self.rate_hz
+
     def lateral_shift(
         self, sensors: SensorPacket, command: Command, state: StanceState
     ) -> tuple[float, float]:
@@ -362,7 +372,7 @@ class QuadrupedSkateboardPD(Controller):
         if model is None:
             return 0.0, 0.0
         gains = self.gains.roll
-        dt = 1.0 / self.rate_hz
+        dt = self._step(sensors.time)
         reference, reference_rate, reference_acceleration = self.roll_reference(sensors, command)
         weight = self.mass * GRAVITY
         com_height = float((state.trunk_origin + state.trunk_rotation @ state.com)[2])
