@@ -207,6 +207,11 @@ class TakeoverStage(_Frozen):
     longest_wait: Positive = Field(le=60.0, description="The MPC takes over by then [s].")
 
 
+class FlightStage(_Frozen):
+    extend_speed: Speed = Field(description="How fast the feet reach down after the shoes [m/s].")
+    max_extension: Positive = Field(le=0.5, description="How far they reach at most [m].")
+
+
 class ImpulseStage(_Frozen):
     band: Speed = Field(description="Largest unexplained velocity change the MPC rides [m/s].")
     sideways: Speed | None = Field(default=None, description="The same across it [m/s].")
@@ -232,7 +237,7 @@ class Stages(_Frozen):
     disturbance: DisturbanceStage | None = None
     takeover: TakeoverStage | None = None
     drop: Used | None = None
-    flight: Used | None = None
+    flight: FlightStage | None = None
     impulse: ImpulseStage | None = None
 
     def used(self) -> tuple[str, ...]:

@@ -41,10 +41,11 @@ __all__ = [
 
 Array = NDArray[np.float64]
 
-# [m/s] the legs' reach after the falling platforms, the PD's (``[flight] extend_speed``):
+# [m/s] the legs' reach after the falling platforms, the default (a pair sets its own in
+# ``[stages.flight]``; the Hovershoes PD's ``[flight] extend_speed`` is the same):
 # the fall's speed 0.1 s after the edge, so the feet keep up with their platforms.
 EXTEND_SPEED: float = 1.0
-# [m] the longest reach, the PD's (``[flight] max_extension``): the legs' stroke from the
+# [m] the longest reach, the default (``[stages.flight] max_extension``): the legs' stroke from the
 # riding posture to near full length, deeper than the highest step a board rolls down.
 MAX_EXTENSION: float = 0.1
 # [ticks] in a row, 10 ms at 500 Hz: the feet stopped by their landed platforms, not a

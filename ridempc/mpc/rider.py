@@ -364,7 +364,11 @@ class MpcRider(Controller):
         # the platforms falling away under the feet (a step), with the ``drop`` stage
         self.drop_watch = DropWatch(DropDetector()) if stages.drop is not None else None
         # the drop ridden by the whole-body QP, the feet after the platforms (``flight``)
-        self.flight = DropFlight(self.drop_watch) if stages.flight is not None else None
+        self.flight = (
+            DropFlight(self.drop_watch, stages.flight.extend_speed, stages.flight.max_extension)
+            if stages.flight is not None
+            else None
+        )
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
