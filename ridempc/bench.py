@@ -54,7 +54,9 @@ over that thread's CPU time in the loop: on a loaded machine, where wall times s
 the other processes, these compare two versions (they leave out the solver process's and
 thread's work, and the loop's waits for them). With ``profile`` (``--profile``) the
 pair rides once more under :class:`~ridempc.tickprofile.PartProfiler`, and ``profile``
-lists each part's hottest functions by their own time.
+lists each part's hottest functions by their own time, ``profile_by_tick`` each kind of
+control tick's (:data:`TICK_KINDS`: the MPC's tick, its build and solve, the plan's take-up,
+the backup's standby, the other ticks), per tick of that kind.
 
 The solvers are the registry's (:data:`ridempc.solvers.QP_KINDS`): the whole-body QPs
 are solved, in the ride and in step 3, by its solver (DAQP), or by ``wbc_solver``
@@ -126,6 +128,7 @@ class PairBench:
     solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
     wbc_solvers: dict[str, dict[str, Any]] = field(default_factory=dict)
     profile: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
+    profile_by_tick: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
 
 
 REFERENCE_ADDITIONS: int = 1_000_000  # the machine reference's loop (reference_ms)
@@ -166,6 +169,11 @@ def _scenario_of(pair: str, scenario: str | None) -> str:
 
 
 BUDGET_PARTS: tuple[str, ...] = ("simulation", "estimator", "mpc", "wbc", "rider_rest")
+# The kinds of control tick the profile is split by (:func:`_tick_kind`): the ride's first
+# STANDBY_WARMUP_S, then the MPC's tick (its part in the loop), the plan's take-up, the
+# backup's standby and the other ticks by their place in the MPC's period; the MPC's build
+# and solve, wherever they run, are a kind of their own.
+TICK_KINDS: tuple[str, ...] = ("warmup", "mpc_tick", "mpc_build", "take_up", "standby", "steady")
 
 
 def _budget(result: Any, parts: dict[str, float], mpc: float) -> dict[str, float]:
@@ -303,6 +311,29 @@ def _profiled(rider: Any, profiler: PartProfiler) -> None:
         (rider, "_adopt_pending", "mpc"),
     ):
         setattr(owner, method, profiler.wrap(getattr(owner, method), part))
+    rider._build_and_run = profiler.wrap_kind(rider._build_and_run, "mpc_build")
+    update = rider.update
+
+    def kind_then_update(sensors: Any, command: Any) -> Any:
+        profiler.begin_tick(_tick_kind(rider, sensors.time))
+        return update(sensors, command)
+
+    rider.update = kind_then_update
+
+
+def _tick_kind(rider: Any, now: float) -> str:
+    """The kind (:data:`TICK_KINDS`) of the control tick ``rider`` is about to run at
+    ``now`` [s], by its place in the MPC's period (:mod:`ridempc.tickphases`)."""
+    from ridempc.mpc.rider import MPC_DIVIDER, STANDBY_WARMUP_S
+
+    if now < STANDBY_WARMUP_S:
+        return "warmup"
+    phase = rider._tick % MPC_DIVIDER
+    if phase == 0:
+        return "mpc_tick"
+    if rider.plan_latency and phase == rider.plan_latency:
+        return "take_up"
+    return "standby" if phase == rider.handover.standby_phase else "steady"
 
 
 def _as_qpsolvers(
@@ -579,9 +610,10 @@ def bench_pair(
     out.cpu_real_time_factor = float(result.sim_time / cpu) if cpu > 0 else float("nan")
     out.tick_phases_cpu_ms = _tick_phases(rider, result.controller_cpu_times)
     if profile:
-        profiler = PartProfiler(BUDGET_PARTS)
+        profiler = PartProfiler(BUDGET_PARTS, TICK_KINDS)
         profiled = _record(robot, board, out.scenario, seconds, wbc_solver, profiler)[0]
         out.profile = profiler.hottest(len(profiled.controller_times), DEFAULT_TOP)
+        out.profile_by_tick = profiler.hottest_by_kind(DEFAULT_TOP)
     if problems:
         mpc = LinearMpc(rider.pair, rider.mpc.reference, rider.mpc.model, rider.mpc.settings)
         times, qp = _mpc_pass(mpc, problems)
@@ -760,6 +792,8 @@ def bench_table(rows: Sequence[PairBench]) -> str:
     profiled = [(r.pair, r.profile) for r in rows if r.profile]
     if profiled:
         lines += profile_table(profiled)
+        by_tick = [(r.pair, r.profile_by_tick) for r in rows if r.profile_by_tick]
+        lines += profile_table(by_tick, by="tick")
     return "\n".join(lines)
 
 

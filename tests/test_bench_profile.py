@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from ridempc.bench import BUDGET_PARTS, bench
+from ridempc.bench import BUDGET_PARTS, TICK_KINDS, bench
 from ridempc.tickprofile import PartProfiler
 
 
@@ -28,6 +28,7 @@ def test_the_json_holds_the_tick_figures_and_the_profile(tmp_path: Path) -> None
         row["tick_phases_ms"]
     )
     assert set(row["profile"]) == set(BUDGET_PARTS)
+    assert {"warmup", "mpc_build"} <= set(row["profile_by_tick"]) <= set(TICK_KINDS)
     for part, functions in row["profile"].items():
         assert functions, part
         shares = [f["share"] for f in functions]
@@ -57,3 +58,28 @@ def test_a_call_is_counted_in_the_part_that_made_it() -> None:
     assert any("sleep" in f["function"] for f in hottest["outer"])
     with pytest.raises(ValueError, match="unknown part 'other'"):
         profiler.wrap(_busy, "other")
+
+
+def test_a_tick_is_counted_in_its_kind_and_a_wrapped_call_in_its_own() -> None:
+    profiler = PartProfiler(("outer", "inner"), ("plain", "busy", "call"))
+    inner = profiler.wrap(_busy, "inner")
+    called = profiler.wrap_kind(profiler.wrap(_busy, "inner"), "call")
+    profiler.start()
+    for tick in range(12):
+        profiler.begin_tick("busy" if tick % 3 == 0 else "plain")
+        if tick % 3 == 0:
+            inner()
+            called()
+        time.sleep(0)
+    profiler.stop()
+    by_kind = profiler.hottest_by_kind(top=20)
+    assert set(by_kind) == {"plain", "busy", "call"}
+    assert any("_busy" in f["function"] and f["calls"] == 4 for f in by_kind["busy"])
+    assert any("_busy" in f["function"] and f["calls"] == 4 for f in by_kind["call"])
+    assert not any("_busy" in f["function"] for f in by_kind["plain"])
+    # the loop's own part (the first) is not the controller's: no sleep in any kind
+    assert not any("sleep" in f["function"] for fs in by_kind.values() for f in fs)
+    # summed over the kinds, the parts see every call
+    assert any("_busy" in f["function"] and f["calls"] == 8 for f in profiler.hottest(12)["inner"])
+    with pytest.raises(ValueError, match="unknown kind 'other'"):
+        profiler.begin_tick("other")
