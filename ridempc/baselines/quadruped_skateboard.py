@@ -426,14 +426,25 @@ class QuadrupedSkateboardPD(Controller):
 
     # ------------------------------------------------------------------ control
 
-    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+    def standby(self, sensors: SensorPacket, command: Command) -> None:
+        """The estimator and the roll's filters (:meth:`lateral_shift`) advanced, no
+        command (the legs' inverse kinematics and torques left out)."""
+        self._advance(sensors, command)
+
+    def _advance(
+        self, sensors: SensorPacket, command: Command
+    ) -> tuple[StanceState, tuple[float, float]]:
+        """What a tick carries to the next: the estimator, the stance, the shift's filters."""
         if not self._ready:
             self.reset(sensors)
         else:
             self.estimator.update(sensors)
-        posture = self.gains.posture
         state = self.observe(sensors)
-        shift, shift_rate = self.lateral_shift(sensors, command, state)
+        return state, self.lateral_shift(sensors, command, state)
+
+    def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
+        state, (shift, shift_rate) = self._advance(sensors, command)
+        posture = self.gains.posture
 
         # trunk: level, pitch held, starting yaw over the feet; centre of mass over the deck
         deck_point = -self.foot_radius * state.deck.normal

@@ -58,6 +58,14 @@ class Controller(ABC):
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         """One control tick."""
 
+    def standby(self, sensors: SensorPacket, command: Command) -> None:
+        """One tick in hot standby (:mod:`ridempc.mpc.handover`): what :meth:`update`
+        carries from tick to tick (filters, integrators, its estimator) advanced, its
+        command not needed. By default the whole update, its command discarded; a law
+        overrides it where the command's own work can be left out, the next update's
+        command the same to the bit."""
+        self.update(sensors, command)
+
     def close(self) -> None:  # noqa: B027 - optional hook
         """Called once the ride has ended (also when it fails or is interrupted): end
         whatever the controller started beside the loop (the MPC's solver process)."""

@@ -284,19 +284,23 @@ class Handover:
         return self._blended(now, self._faded(now, backup))
 
     def _backup(self, sensors: SensorPacket, command: Command, needed: bool) -> MotorCommand:
-        """The backup's command: run this tick where it rides, is blended or ``needed``, on
-        its first tick, and every :attr:`standby_every` ticks in standby."""
+        """The backup's command: run this tick where it rides, is blended or ``needed`` and
+        on its first tick; every :attr:`standby_every` ticks in standby only its state
+        advanced (:meth:`~ridempc.controllers.base.Controller.standby`), the command it
+        last gave kept, which nothing reads before its next update."""
         tick, self._ticks = self._ticks, self._ticks + 1
         every = self.standby_every
         standby = tick % every == self.standby_phase if every > 1 else True
         if (
             self._backup_command is None
             or needed
-            or standby
             or self.on_backup
             or self._switch_time is not None
         ):
             self._backup_command = self.backup.update(sensors, command)
+        elif standby:  # its command not read before the next update: its state only
+            # (a stand-in law without the Controller's hook: updated in full)
+            getattr(self.backup, "standby", self.backup.update)(sensors, command)
         return self._backup_command
 
     def _faded(self, now: float, command: MotorCommand) -> MotorCommand:
