@@ -94,6 +94,8 @@ DEFAULT_SETTINGS: dict[str, Any] = {
     "warm_starting": True,
 }
 _SOLVED = osqp.SolverStatus.OSQP_SOLVED
+# OSQP's infinity, to which its Python ``update`` clips the bounds (written here as it does)
+_INFINITY = float(osqp.constant("OSQP_INFTY"))
 _PATTERN_TOLERANCE = 1e-9  # values this small outside the pattern are round-off
 
 
@@ -149,6 +151,15 @@ class SolveOutcome(NamedTuple):
     iterations: int
     ok: bool
     seconds: float
+
+
+class _Result(NamedTuple):
+    """One OSQP solve (:meth:`MpcQP.run`): the primal and dual solutions and its info
+    (``status``, ``status_val``, ``iter``)."""
+
+    x: Array
+    y: Array
+    info: Any
 
 
 class _Update(NamedTuple):
@@ -450,10 +461,17 @@ class MpcQP:
         return _Update(self._weights(problem), values, lower, upper, None, None)
 
     def _write(self, update: _Update) -> None:
-        """``update`` written into OSQP: the values, then the warm start if any."""
-        self._solver.update(Px=update.weights, Ax=update.values, l=update.lower, u=update.upper)
+        """``update`` written into OSQP: the values, then the warm start if any; into the
+        extension's solver, as OSQP's Python ``update`` writes them (the bounds clipped to
+        its infinity, then the vectors, then the matrices), without what it adds per call
+        (importing the extension twice to read that infinity, copies kept for derivatives
+        nobody asks for)."""
+        solver = self._solver._solver
+        lower = np.maximum(update.lower, -_INFINITY)
+        solver.update_data_vec(q=None, l=lower, u=np.minimum(update.upper, _INFINITY))
+        solver.update_data_mat(P_x=update.weights, P_i=None, A_x=update.values, A_i=None)
         if update.primal is not None:
-            self._solver.warm_start(x=update.primal, y=update.dual)
+            solver.warm_start(update.primal, update.dual)
 
     def _unpack(self, z: Array) -> tuple[Array, Array]:
         n, nx = self.horizon, self.nx
@@ -507,13 +525,21 @@ class MpcQP:
         try:
             if staged is not None:
                 self._write(staged)
-            result = self._solver.solve(raise_error=False)
+            result = self._run_osqp()
             status, iterations = str(result.info.status), int(result.info.iter)
             ok = result.info.status_val == _SOLVED
         except (osqp.OSQPException, ValueError) as exc:
             result, status, iterations, ok = None, f"solver error ({exc!r})", 0, False
         osqp_returned(result.info.status_val if result is not None else _SOLVED)
         return SolveOutcome(result, status, iterations, ok, time.perf_counter() - begin)
+
+    def _run_osqp(self) -> _Result:
+        """OSQP's solve on the extension's solver: its solution and info as OSQP's Python
+        ``solve`` returns them, without the copy of every info field it makes per call."""
+        solver = self._solver._solver
+        solver.solve()
+        solution = solver.solution
+        return _Result(solution.x, solution.y, solver.info)
 
     def finish(self, started: StartedSolve, outcome: SolveOutcome) -> Plan:
         """The plan of a started (:meth:`start`) and run (:meth:`run`) solve, or the
