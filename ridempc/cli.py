@@ -126,7 +126,8 @@ def _parser() -> argparse.ArgumentParser:
     bench.add_argument(
         "--profile",
         action="store_true",
-        help="ride each pair again under cProfile: the hottest functions of each part of the tick",
+        help="ride each pair again under cProfile: the hottest functions of each part of the "
+        "tick and of each kind of tick (MPC tick, its build, take-up, standby, the others)",
     )
     bench.add_argument(
         "--json", type=options.path, default=None, help="also write the results here"
