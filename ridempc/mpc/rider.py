@@ -69,8 +69,7 @@ from __future__ import annotations
 import copy
 import math
 import time
-from concurrent.futures import Future
-from functools import cache, partial
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -81,8 +80,6 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.delay import predicted_start
-from ridempc.mpc.divergence import DivergentDeviation, Probation
 from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.flight import DropFlight
 from ridempc.mpc.foot_spread import spread_lines
@@ -92,9 +89,7 @@ from ridempc.mpc.handover import (
     RETURN_DWELL_S,
     STANDBY_DIVIDER,
     Handover,
-    deviation,
     share_estimator,
-    standby_every,
 )
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import (
@@ -107,17 +102,16 @@ from ridempc.mpc.manoeuvre import (
 )
 from ridempc.mpc.pairs import check_library_names, load_mpc_pair
 from ridempc.mpc.payload import PayloadEstimator
-from ridempc.mpc.plan import Plan
+from ridempc.mpc.plan_book import PlanBook
+from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY, PlanSolver
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
-from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.push_handover import deviation_deferred
 from ridempc.mpc.push_side import PushSide
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
-from ridempc.mpc.solver_process import Reply, SolverProcess, forks
-from ridempc.mpc.solver_thread import SolverThread
+from ridempc.mpc.solver_process import SolverProcess
 from ridempc.mpc.stages.base import (
     ControlTick,
     DriftSource,
@@ -127,7 +121,7 @@ from ridempc.mpc.stages.base import (
     present,
 )
 from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper
-from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
+from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve, build_and_run
 from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.mpc.stages.deck_roll import deck_stages
 from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observer
@@ -135,12 +129,13 @@ from ridempc.mpc.stages.feet_targets import FeetTargets
 from ridempc.mpc.stages.manoeuvre_choice import ManoeuvreChoice
 from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
 from ridempc.mpc.stages.payload_models import PayloadModels
+from ridempc.mpc.stages.plan_watch import STANDBY_WARMUP_S, PlanWatch
 from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_stages
 from ridempc.mpc.stages.support import contacts_to_feet, foot_support
 from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, PushWatch, handover_triggers
 from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.mpc.stagger import standby_phase
-from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
+from ridempc.mpc.state_map import StateMap, forward_speed
 from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -153,24 +148,21 @@ from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.targets import WbcOutput
 from ridempc.wbc.torque_lead import TorqueLead
 
-__all__ = ["BACKUP_LAW", "MpcRider", "platform_feet", "rolling_platforms"]
+__all__ = [
+    "BACKUP_LAW",
+    "MPC_DIVIDER",
+    "PROCESS_MIN_LATENCY",
+    "STANDBY_WARMUP_S",
+    "MpcRider",
+    "platform_feet",
+    "rolling_platforms",
+]
 
 Array = NDArray[np.float64]
 MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
 # The law the ride is handed to when the MPC or its QP fails (ridempc.mpc.handover): the
 # pair's PD baseline, which balances every pair from the same sensors.
 BACKUP_LAW: str = "pd"
-# [s] how long from the ride's start the backup's standby runs every tick while the MPC is
-# on probation: an unknown model (a payload's offset) tips the rider within 0.5-1 s of the
-# start, where the backup's filters are still settling from rest; later its 33 Hz standby
-# keeps them current (every tick throughout cost 8 % of the loop's speed).
-STANDBY_WARMUP_S: float = 1.0
-# Least plan_latency [ticks] whose solves go to the solver process: at 1 the loop takes the
-# plan up after the next tick's simulation and estimate, about 0.5 ms after sending the
-# state, where the process builds and solves in 2.3 ms (Hovershoes, median) and the thread,
-# which overlaps OSQP's iterations with the loop (0.7 ms of building holds the lock), waits
-# less (docs/tuning.md).
-PROCESS_MIN_LATENCY: int = 2
 
 
 def _backup(robot: Robot, board: str) -> Controller:
@@ -178,14 +170,6 @@ def _backup(robot: Robot, board: str) -> Controller:
     from ridempc.controllers.registry import CONTROLLERS  # the registry imports this module
 
     return CONTROLLERS[BACKUP_LAW](robot, board)
-
-
-@cache
-def _solver_thread() -> SolverThread:
-    """The thread the MPC's solves run in beside the control loop, one for the process
-    (made at its first use): a rider per ride, and rides one after another (``compare``'s
-    seeds), would otherwise each leave an idle thread behind."""
-    return SolverThread("mpc")
 
 
 class MpcRider(Controller):
@@ -207,13 +191,6 @@ class MpcRider(Controller):
     """
 
     rate_hz = 500.0
-    # Where a solve with a ``plan_latency`` is built and run (its plan taken up
-    # ``plan_latency`` ticks on whichever: the same ride, bit for bit): ``process``, a
-    # child process on the other core (mpc/solver_process.py) from PROCESS_MIN_LATENCY
-    # on, else, or where the process cannot fork (in a sweep's worker, off the main
-    # thread), the thread; ``thread``, the solver thread (its Python holds the loop's
-    # lock: only OSQP's iterations run beside the loop); ``tick``, in its tick.
-    off_tick: str = "process"
     # Whether the solver process sends each problem back with its plan (the bench keeps
     # them; the ride needs the plan only).
     keeps_problems: bool = False
@@ -338,29 +315,19 @@ class MpcRider(Controller):
         )
         self.feet_targets = FeetTargets(self.feet, self.wbc, self.mpc)
         self._support: tuple[Contact, ...] | None = None  # per foot, this MPC step
-        self._contacts: tuple[Contact, ...] = ()  # per library contact, the last MPC step
         self._tick = 0
-        self._plan: Plan | None = None
-        self._plan_frame = PlanarFrame()
-        self._last_problem: MpcProblem | None = None
-        self._plan_time = 0.0
+        self.book = PlanBook(self.force_filter)  # the plan in force (mpc/plan_book.py)
         self.turn = TurnSoFar()  # the commanded yaw rate integrated over the ride
         self._hold: MotorCommand | None = None
         self._wbc_failures = 0  # in all
         self._hold_reason: str | None = None
         self._hold_time: float | None = None
-        self._mpc_ms: list[float] = []  # each tick: building the problem and solving it
-        self._mpc_qp_ms: list[float] = []  # each tick's QP: updating it and solving it
         self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
-        self._pending: PendingSolve | None = None
-        self._worker: SolverProcess[BuildInputs, Built] | None = None
+        # where each solve runs and when its plan takes over (mpc/plan_solver.py)
+        self.solver = PlanSolver(latency, self._build_and_run, self._build_in_process)
         self._sent_reference: MotionReference | None = None  # the last one the build got
-        self._mpc_failures = 0  # the MPC's fallbacks, as of the last plan taken up
         self._wbc_ms: list[float] = []
         self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
-        self._deviation = 0.0  # [-] the MPC's state from its reference (handover.deviation)
-        self._divergence = DivergentDeviation()  # where that deviation is heading
-        self._probation = Probation()  # whether the MPC has shown its model holds the rider
         # the platforms falling away under the feet (a step), with the ``drop`` stage
         self.drop_watch = DropWatch(DropDetector()) if stages.drop is not None else None
         # the drop ridden by the whole-body QP, the feet after the platforms (``flight``)
@@ -385,6 +352,7 @@ class MpcRider(Controller):
         self.readiness = start_readiness(stages.takeover, RETURN_DWELL_S)
         if self.readiness is not None:
             self.handover.start_on_backup()
+        self.watch = PlanWatch(self.handover, self.readiness, self.payload, self._standby_every)
         self._diagnostics: dict[str, float] = {}
         # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
         self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass)
@@ -456,7 +424,7 @@ class MpcRider(Controller):
         if self.flight is not None:
             self.flight.reset()
         self._tick = 0
-        self._plan = None
+        self.book.plan = None
         estimate = self.estimator.state
         if estimate is not None:
             self._anchor(estimate, sensors.time)
@@ -493,7 +461,7 @@ class MpcRider(Controller):
         starting = self.handover.starting
         out = self.handover.step(sensors, command, primary, failure, self._fit())
         if starting and not self.handover.starting:  # its rate measured the backup's ride
-            self._divergence.reset()  # away from plans it did not follow
+            self.watch.divergence.reset()  # away from plans it did not follow
         self._diagnostics["on_backup"] = float(self.handover.on_backup)
         if not out.is_finite():
             return self._safe_hold(sensors, f"no finite command from the backup law: {failure}")
@@ -521,9 +489,10 @@ class MpcRider(Controller):
         try:
             if self._tick % MPC_DIVIDER == 0:
                 self._mpc_tick(estimate, command, sensors.time)
-            if self._pending is not None and self._tick >= self._pending.due:
-                self._adopt_pending()
-            if self._plan is None:
+            solve = self.solver.due(self._tick)
+            if solve is not None:
+                self._adopt_pending(solve)
+            if self.book.plan is None:
                 return None, "no MPC plan"
             out, solved = self._wbc_tick(estimate, sensors.time)
         except WbcFailed as exc:
@@ -537,12 +506,12 @@ class MpcRider(Controller):
         repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
         stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
         check = HandoverCheck(
-            self._plan,
+            self.book.plan,
             self._diagnostics.get("wbc_slack", 0.0),
-            self._deviation,
+            self.book.deviation,
             stroke,
-            self._probation.proven,
-            self._divergence,
+            self.watch.probation.proven,
+            self.watch.divergence,
         )
         for trigger in self.triggers:  # the first reason hands the ride over
             reason = trigger(check)
@@ -556,10 +525,10 @@ class MpcRider(Controller):
         """Whether the MPC may ride again: its plan solved (not the last one shifted) and
         the state near its reference (:func:`~ridempc.mpc.handover.deviation`) and not
         heading away from it faster than planned (:mod:`~ridempc.mpc.divergence`)."""
-        plan = self._plan
+        plan = self.book.plan
         if self.handover.starting:  # the start's backup: until the MPC is ready
             return self.readiness is not None and self.readiness.ready
-        settled = max(self._deviation, self._divergence.value) <= RETURN_DEVIATION
+        settled = max(self.book.deviation, self.watch.divergence.value) <= RETURN_DEVIATION
         return plan is not None and not plan.fallback and settled
 
     def hold_speed(self) -> None:
@@ -574,7 +543,7 @@ class MpcRider(Controller):
         chosen = self.choice(self.manoeuvre, command, now, speed, rider_speed, coasted)
         began = chosen is not None
         if chosen is not None:
-            self._divergence.reset()  # a new reference: its deviation steps, no divergence
+            self.watch.divergence.reset()  # a new reference: its deviation steps, no divergence
             self.manoeuvre = chosen
             switched = chosen.kind == REPUSH  # from wherever the coast left the rider
             # any switch starts mid-turn: the reference's heading already carries the turn
@@ -589,21 +558,21 @@ class MpcRider(Controller):
         mapped = self._mapped(estimate)
         coasting = self._coasting(t_ref)
         balancing = self.manoeuvre.kind == HOLD or coasting
-        held = self.handover.on_backup or self._pending is not None  # the plan not followed
+        held = self.handover.on_backup or self.solver.pending is not None  # the plan not followed
         tick = MpcTick(
             estimate,
             now,
             speed,
             balancing,
-            self._plan,
-            self._plan_time,
+            self.book.plan,
+            self.book.time,
             0.0,
             held,
             self._diagnostics,
         )
         if self.payload_models is not None:
             self.payload_models.absorb(tick)
-        pushing = Contact.GROUND in self._contacts  # a foot on the ground goes straight
+        pushing = Contact.GROUND in self.book.contacts  # a foot on the ground goes straight
         steering = balancing or (self.manoeuvre.kind == REPUSH and not pushing)
         limit = partial(self.stance_roll, tick=tick) if self.stance_roll is not None else None
         names = self.layout.names
@@ -618,7 +587,7 @@ class MpcRider(Controller):
         self._follow_board(mapped, here, turn, now, coasting, carried)
         x0 = self.turn.unwrapped(self.map.state(mapped), here, self.layout.headings)
         started = time.perf_counter()
-        turned = math.remainder(self.map.frame.yaw - self._plan_frame.yaw, 2.0 * math.pi)
+        turned = math.remainder(self.map.frame.yaw - self.book.frame.yaw, 2.0 * math.pi)
         tick = tick._replace(frame_turn=turned)  # the frame has moved onto the board
         drift: Array | None = None
         for source in self.drifts:  # the disturbance observers' drifts, summed in order
@@ -626,7 +595,7 @@ class MpcRider(Controller):
             if more is not None:
                 drift = more if drift is None else drift + more
         # the plan starts where it takes over (mpc/delay.py): the first plan is waited for
-        late = self.plan_latency > 0 and self._plan is not None and self.predicts_start
+        late = self.plan_latency > 0 and self.book.plan is not None and self.predicts_start
         delay = self.plan_latency / self.rate_hz if late else 0.0
         inputs = BuildInputs(  # what the loop's state says now, copied: the build may run
             self.manoeuvre.reference_time(now + delay),  # beside the loop's next ticks,
@@ -642,8 +611,8 @@ class MpcRider(Controller):
             copy.copy(self.lean),
             self.shoes.frozen() if self.shoes is not None else None,
             (self.manoeuvre.kind, self.manoeuvre.target),
-            self._plan.first_input if self._plan is not None else None,
-            self._contacts,
+            self.book.plan.first_input if self.book.plan is not None else None,
+            self.book.contacts,
             None if self.mpc.reference is self._sent_reference else self.mpc.reference,
             began,
             command.lateral_offset,
@@ -653,63 +622,37 @@ class MpcRider(Controller):
         # the frame the plan is in: the map's moves on at the next tick, the plan only
         # when this one takes over
         pending = PendingSolve(self.map.frame, now + delay, self._tick + self.plan_latency)
-        if self.plan_latency == 0 or self._plan is None:  # the first plan is waited for
-            self._adopt(pending, self._build_and_run(inputs))
-        else:
-            self._pending = pending._replace(reply=self._submit(inputs))
+        built = self.solver.start(pending, inputs, first=self.book.plan is None)
+        if built is not None:
+            self._adopt(pending, built)
         self._mpc_main_s += time.perf_counter() - started
 
-    def _submit(self, inputs: BuildInputs) -> Future[Built] | Reply[Built]:
-        """The build and solve of ``inputs`` started where ``off_tick`` says."""
-        where = self.off_tick
-        process = where == "process" and self.plan_latency >= PROCESS_MIN_LATENCY
-        if process and (self._worker is not None or forks()):
-            if self._worker is None:
-                self._worker = SolverProcess(self._build_in_process)
-            return self._worker.submit(inputs)
-        if where in ("process", "thread"):
-            return _solver_thread().submit(partial(self._build_and_run, inputs))
-        future: Future[Built] = Future()
-        future.set_result(self._build_and_run(inputs))
-        return future
+    @property
+    def off_tick(self) -> str:
+        """Where a late plan's solve runs (:data:`~ridempc.mpc.plan_solver.OFF_TICK`)."""
+        return self.solver.off_tick
+
+    @off_tick.setter
+    def off_tick(self, where: str) -> None:
+        self.solver.off_tick = where
+
+    @property
+    def _worker(self) -> SolverProcess[BuildInputs, Built] | None:
+        return self.solver.worker
+
+    @property
+    def _pending(self) -> PendingSolve | None:
+        return self.solver.pending
 
     def close(self) -> None:
         """End the MPC's solver process, if one was started (at the end of a ride)."""
-        if self._worker is not None:
-            self._worker.close()
-            self._worker = None
+        self.solver.close()
 
     def _build_and_run(self, inputs: BuildInputs) -> Built:
-        """The MPC problem of one tick built from ``inputs`` (and the build's own state:
-        the QP and its warm start, a re-push's blend, the crouch's start, the static
-        shifts kept by key) and solved; in the loop's tick, the solver thread or the
-        solver process (``off_tick``), the same either way."""
-        started = time.perf_counter()
-        if inputs.reference is not None:
-            self.mpc.reference = inputs.reference
-        x0 = inputs.x0
-        if inputs.delay > 0.0 and inputs.first_input is not None:
-            mpc = self.mpc
-            x0 = predicted_start(
-                mpc.model,
-                mpc.reference,
-                inputs.t_ref,
-                x0,
-                inputs.first_input,
-                inputs.drift,
-                inputs.delay,
-                mpc.settings.dt,
-            )
-        problem = self._shaped(self.mpc.problem(inputs.t_ref, x0, inputs.drift), inputs)
-        if self.mpc.qp is None:
-            self.mpc.qp = self.mpc.build_qp(problem)
-        build = time.perf_counter() - started
-        qp = self.mpc.qp
-        plan = qp.finish(qp.start(problem), qp.run())
-        weights, reference = problem.state_weights, problem.state_reference
-        gap = deviation(problem.initial_state, reference[0], weights)
-        expected = deviation(plan.states[1], reference[1], weights)
-        return Built(plan, problem.contacts[0], build, qp.failures, problem, gap, expected)
+        """The MPC problem of one tick built from ``inputs``, shaped by the rider's
+        problem shapers in order (:attr:`shapers`) and solved
+        (:func:`~ridempc.mpc.stages.build.build_and_run`)."""
+        return build_and_run(self.mpc, self.shapers, inputs)
 
     def _build_in_process(self, inputs: BuildInputs) -> Built:
         """:meth:`_build_and_run` in the solver process, its reply without the problem
@@ -717,56 +660,26 @@ class MpcRider(Controller):
         built = self._build_and_run(inputs)
         return built if self.keeps_problems else built._replace(problem=None)
 
-    def _shaped(self, problem: MpcProblem, inputs: BuildInputs) -> MpcProblem:
-        """``problem`` shaped by the rider's problem shapers, in order (:attr:`shapers`)."""
-        for shaper in self.shapers:
-            problem = shaper(problem, inputs)
-        return problem
-
-    def _adopt_pending(self) -> None:
-        """The pending solve's plan taken up, once its tick has come (waiting for it if
-        the solver is still at it)."""
-        solve, self._pending = self._pending, None
-        assert solve is not None and solve.reply is not None
+    def _adopt_pending(self, solve: PendingSolve) -> None:
+        """The pending ``solve``'s plan taken up, its tick come (waiting for it if the
+        solver is still at it)."""
+        assert solve.reply is not None
         started = time.perf_counter()
         self._adopt(solve, solve.reply.result())
         self._mpc_main_s += time.perf_counter() - started
 
     def _adopt(self, solve: PendingSolve, built: Built) -> None:
         """The plan of ``solve`` (its problem ``built`` and solved) in force from this tick
-        on, timed from the state it was solved from."""
-        plan = built.plan
-        self._contacts, self._last_problem = built.contacts, built.problem
-        self._mpc_failures = built.failures
-        self._deviation = built.deviation
+        on, timed from the state it was solved from, and watched by the handover."""
+        self.book.record(built)
         self._diagnostics["mpc_deviation"] = built.deviation
-        riding = not self.handover.on_backup  # the peak is the MPC's own rides'
-        self._divergence.update(solve.time, built.deviation, self._com_height, riding)
-        self._divergence.expect(built.expected)
-        if riding:
-            settled = not plan.fallback and built.deviation <= RETURN_DEVIATION
-            self._probation.update(solve.time, settled, RETURN_DWELL_S)
-        else:
-            self._probation.restart()
-        if self.readiness is not None and self.handover.starting:
-            in_band = not plan.fallback and built.deviation <= RETURN_DEVIATION
-            settling = self.payload.estimate.settling() if self.payload is not None else None
-            # a stop is the selector's ride-out of a push, which the backup rides too
-            commanded = self.manoeuvre.kind not in (HOLD, "stop")
-            self.readiness.update(solve.time, settling, in_band, commanded)
-        warming = not self._probation.proven and solve.time < STANDBY_WARMUP_S
-        in_return_band = max(built.deviation, self._divergence.value) <= RETURN_DEVIATION
-        self.handover.standby_every = standby_every(self._standby_every, warming, in_return_band)
-        self._mpc_ms.append(1e3 * (built.build_s + plan.solve_time))
-        self._mpc_qp_ms.append(1e3 * plan.solve_time)
-        if not np.all(np.isfinite(plan.states)):
-            raise RidempcError(f"MPC plan not finite (status {plan.status})")
-        if self.force_filter is not None:
-            plan = plan._replace(first_input=self.force_filter(plan.first_input, solve.time))
-        self._plan, self._plan_time, self._plan_frame = plan, solve.time, solve.frame
+        # a stop is the selector's ride-out of a push, which the backup rides too
+        commanded = self.manoeuvre.kind not in (HOLD, "stop")
+        self.watch.observe(solve.time, built, self._com_height, commanded)
+        plan = self.book.adopt(solve, built)
         self._set_support(built.contacts)
         self._diagnostics.update(
-            mpc_ms=self._mpc_ms[-1],
+            mpc_ms=self.book.ms[-1],
             mpc_fallback=float(plan.fallback),
             mpc_iterations=float(plan.iterations),
         )
@@ -827,12 +740,12 @@ class MpcRider(Controller):
     def _wbc_tick(self, estimate: EstimatedState, now: float) -> tuple[MotorCommand, WbcOutput]:
         """The whole-body QP's motor command for the plan in force at ``now`` [s], and its
         output."""
-        plan = self._plan
+        plan = self.book.plan
         assert plan is not None
-        wanted = self._read_plan(plan, self._plan_frame, (now - self._plan_time) * 30.0)
+        wanted = self._read_plan(plan, self.book.frame, self.book.age(now))
         assert self._support is not None  # set by the MPC tick, which runs first
         t_ref = self.manoeuvre.reference_time(now)
-        feet = self.feet_targets(self._support, t_ref, estimate, self._plan_frame)
+        feet = self.feet_targets(self._support, t_ref, estimate, self.book.frame)
         swing_acceleration = None
         if self.flight is not None and self.flight.flying:  # no foot stands: mpc/flight.py
             feet, swing_acceleration = self.flight.feet(feet, estimate)
@@ -872,7 +785,7 @@ class MpcRider(Controller):
     def mpc_tick_ms(self) -> tuple[float, ...]:
         """Each MPC tick's time so far [ms]: building the problem and solving it (the
         solve's own time, not the ticks it runs alongside)."""
-        return tuple(self._mpc_ms)
+        return tuple(self.book.ms)
 
     @property
     def mpc_loop_seconds(self) -> float:
@@ -886,16 +799,16 @@ class MpcRider(Controller):
         its whole tick (``mpc_tick_ms``: building the problem too), median and p99 [ms]."""
         out: dict[str, Any] = {}
         for key, values in (
-            ("mpc_solve_ms", self._mpc_qp_ms),
-            ("mpc_tick_ms", self._mpc_ms),
+            ("mpc_solve_ms", self.book.qp_ms),
+            ("mpc_tick_ms", self.book.ms),
             ("wbc_solve_ms", self._wbc_ms),
         ):
             if values:
                 ms = np.asarray(values)
                 out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
-        out["mpc_solves"] = len(self._mpc_ms)
+        out["mpc_solves"] = len(self.book.ms)
         out["speed_preview_s"] = self.commands.speed_preview_s()
-        out["mpc_fallbacks"] = self._mpc_failures
+        out["mpc_fallbacks"] = self.book.failures
         out["wbc_failures"] = self._wbc_failures
         out["wbc_cold_retries"] = self.wbc.qp.cold_retries
         out["wbc_daqp_solves"] = self.wbc.qp.fallbacks
@@ -905,7 +818,7 @@ class MpcRider(Controller):
         out["mpc_takeover_s"] = 0.0 if self.readiness is None else self.handover.takeover_s
         if self.readiness is not None:
             out["takeover"] = self.readiness.summary()
-        out["deviation_divergent_max"] = self._divergence.peak
+        out["deviation_divergent_max"] = self.watch.divergence.peak
         out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
         out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
         out["flights_s"] = list(self.flight.starts) if self.flight is not None else None
