@@ -474,7 +474,7 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd(monkeypatch) -> No
     she stands: with the pair's terminal factor (30) her plans bring her back to the
     reference, at 10 they let her roll back at 0.05 m/s. The MPC from the start (not the
     pair's PD start, ``takeover``: its switch's transient is not what is measured here)."""
-    monkeypatch.setattr("ridempc.mpc.rider.start_readiness", lambda *args: None)
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
     cassie = load_robot("cassie")
     rider = MpcRider(cassie, "hovershoes")
     assert rider.pair.description.wbc.tracking_gain_scale == pytest.approx(0.1)

@@ -1,67 +1,49 @@
 """``mpc``: the skateboard paper's pipeline (section V) riding any pair with an MPC library.
 
-The rider is a loop over stages, each of one protocol (:mod:`ridempc.mpc.stages.base`),
-built once from the pair file's ``[stages.*]`` (``pairs/<robot>-<board>.toml``) and listed,
-in the order they act, in one place, :meth:`MpcRider._build_stages` (``observers``,
-``wbc_observers``, ``drifts``, ``shapers``, ``triggers``). Every 2 ms (500 Hz) the rider
+The rider is a short loop over stages, each of one protocol
+(:mod:`ridempc.mpc.stages.base`), built once from the pair file's ``[stages.*]``
+(``pairs/<robot>-<board>.toml``) by :class:`~ridempc.mpc.rider_parts.RiderParts` and listed
+there, in the order they act. Every 2 ms (500 Hz) the rider
 
 1. estimates its state from the sensors (:class:`~ridempc.estimation.StateEstimator`, the
-   board from its own feet), each shoe's heading from its direction of travel
-   (:mod:`~ridempc.mpc.shoe_heading`), and updates the **tick observers** (the platforms
-   falling away, :class:`~ridempc.mpc.stages.triggers.DropWatch`, and the drop's flight,
-   :class:`~ridempc.mpc.flight.DropFlight`; the stance's loads for the payload,
+   board from its own feet), each shoe's heading from its direction of travel, and
+   updates the **tick observers** (``observers``: the platforms falling away,
+   :class:`~ridempc.mpc.stages.triggers.DropWatch`, the drop's flight,
+   :class:`~ridempc.mpc.flight.DropFlight`, the stance's loads for the payload,
    :mod:`~ridempc.mpc.stages.payload_models`);
-2. every 15th tick (30 Hz), chooses the manoeuvre the command asks for
-   (:mod:`~ridempc.mpc.stages.manoeuvre_choice`: a push-off or a speed change follows its
-   library trajectory, then rides on; on the skateboard it coasts and pushes again), reads the
-   commands over the horizon (the command source,
-   :class:`~ridempc.mpc.stages.commands.CommandHorizon`; on the skateboard a yaw rate
-   steered by the deck's roll, within what the stance holds,
-   :class:`~ridempc.mpc.stages.deck_roll.StanceRoll`), maps the estimate into the library
-   frame (:class:`~ridempc.mpc.state_map.StateMap`, which follows the board sideways onto
-   the reference's line, and on the Segway turns with its direction of travel), sums the
-   **drift sources** (disturbance observers: the deck's torque, the payload, the steady
-   disturbance, the lean's pull; :mod:`~ridempc.mpc.stages.deck_roll`,
-   :mod:`~ridempc.mpc.stages.drifts`) into the MPC's rates, and builds the linear MPC's
-   problem (:class:`~ridempc.mpc.controller.LinearMpc`) shaped by the **problem shapers**
-   in order (:mod:`~ridempc.mpc.stages.manoeuvre_shapers`: coasting, the commanded roll, a
-   re-push's blend, the turn; :mod:`~ridempc.mpc.stages.board_shapers`: the Segway's crouch
-   and lean, the Hovershoes' lines and drags, the swing's held forces). It is solved in the
-   tick, the solver thread or a process of its own (``off_tick``), from the state
-   predicted at the plan's take-up ``plan_latency`` ticks later (:mod:`ridempc.mpc.delay`;
-   else the tick's, its time shifted: the pair's ``predict_start``), waited for then
-   whatever the machine, the ticks between following the previous plan in its own frame;
-3. turns the plan into whole-body targets (:class:`~ridempc.mpc.plan_targets.PlanReader`:
-   the plan interpolated over the 1/30 s step, its first input's forces, low-passed on the
-   Hovershoes, :mod:`~ridempc.mpc.force_filter`; the feet's support and swing,
+2. every :data:`MPC_DIVIDER`-th tick (30 Hz), asks the **command sources**: the manoeuvre
+   the command asks for (:class:`~ridempc.mpc.stages.manoeuvre_choice.ManoeuvreChoice`), the
+   commanded roll and turn over the horizon and the state in the library frame moved onto
+   the board (:class:`~ridempc.mpc.stages.frame_follow.CommandedFrame`, reading
+   :class:`~ridempc.mpc.stages.commands.CommandHorizon`); sums the **drift sources**
+   (``drifts``, disturbance observers: the deck's torque, the payload, the steady
+   disturbance, the lean's pull) into the MPC's rates; and has the problem built, shaped
+   by the **problem shapers** in order (``shapers``: coasting, the commanded roll, a
+   re-push's blend, the turn, the Segway's crouch and lean, the Hovershoes' lines and
+   drags, the swing's held forces) and solved (:func:`~ridempc.mpc.stages.build.build_and_run`)
+   in the tick, the solver thread or the solver process
+   (:class:`~ridempc.mpc.plan_solver.PlanSolver`), from the state predicted at the plan's
+   take-up ``plan_latency`` ticks later (:mod:`ridempc.mpc.delay`);
+3. takes a plan up at its tick (:class:`~ridempc.mpc.plan_book.PlanBook`, the handover's
+   :class:`~ridempc.mpc.stages.plan_watch.PlanWatch`), reads it into whole-body targets
+   (:class:`~ridempc.mpc.plan_targets.PlanReader`; the feet's support and swing,
    :mod:`~ridempc.mpc.stages.feet_targets`; each shoe's drag as its platform's
-   acceleration) and solves the 500 Hz whole-body QP
-   (:class:`~ridempc.wbc.WholeBodyController`, :mod:`ridempc.mpc.rider_wbc`);
-4. updates the observers of the QP's output (the shoes' observer, the push's watch), asks
-   the **handover triggers** in order (:mod:`~ridempc.mpc.stages.triggers`) why the MPC
-   cannot ride, and sends the QP's torques as feedforward, each led over its motor's
-   torque delay (:mod:`~ridempc.wbc.torque_lead`), with its joint targets to the motor PD
-   (:func:`~ridempc.mpc.rider_wbc.tracking_gains`).
+   acceleration) and solves the whole-body QP (:class:`~ridempc.wbc.WholeBodyController`);
+4. updates the observers of the QP's output (``wbc_observers``: the shoes' observer, the
+   push's watch), asks the **handover triggers** in order (``triggers``,
+   :mod:`~ridempc.mpc.stages.triggers`) why the MPC cannot ride, and sends the QP's torques
+   as feedforward, each led over its motor's torque delay (:mod:`~ridempc.wbc.torque_lead`),
+   with its joint targets to the motor PD.
 
 **Fallback.** The whole-body QP always returns a command (slack on its soft rows,
 :mod:`ridempc.wbc.elastic`). If the MPC's QP fails (its previous plan shifted by one step is
 then used), anything raises, the estimate is not finite, or a trigger gives a reason, the
-ride is handed to the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC,
-reading the rider's estimate), the motor commands blended, and handed back once the MPC's
-plans have solved and its state has stayed near the reference for a while
-(:mod:`~ridempc.mpc.handover`); each handover is in ``summary()``'s ``fallbacks``. With the
-pair's ``takeover`` stage the ride starts on that backup, the MPC planning beside it, and
-the MPC takes over once ready (:mod:`~ridempc.mpc.readiness`; ``summary()``'s
-``mpc_takeover_s``). Only where the backup too has no finite command are the joints held
-where they are (``safe_hold``).
-
-**Towards a few hundred lines.** What is left here beyond the loop: the commanded roll's
-and turn's composition and the library frame's turn in :meth:`MpcRider._mpc_tick` (the
-command source's), the solve's dispatch to the tick, thread or process (:meth:`MpcRider._submit`,
-:meth:`MpcRider._build_and_run`: a solver stage beside :mod:`~ridempc.mpc.solver_process`),
-the handover's bookkeeping at a plan's take-up (:meth:`MpcRider._adopt`: divergence,
-probation, readiness, the backup's standby; an *observer* of the plans) and the wiring of
-the remaining stages in ``__init__`` (a factory per stage, read from the pair file).
+ride is handed to the pair's PD baseline (:data:`BACKUP_LAW`, in standby beside the MPC),
+the motor commands blended, and handed back once the MPC's plans have solved and its state
+has stayed near the reference for a while (:mod:`~ridempc.mpc.handover`); each handover is
+in ``summary()``'s ``fallbacks``. With the pair's ``takeover`` stage the ride starts on that
+backup until the MPC is ready (:mod:`~ridempc.mpc.readiness`). Only where the backup too
+has no finite command are the joints held where they are (``safe_hold``).
 """
 
 from __future__ import annotations
@@ -69,75 +51,28 @@ from __future__ import annotations
 import copy
 import math
 import time
-from functools import partial
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.boards.canonical import board_state_columns
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
-from ridempc.estimation import EstimatedState, StateEstimator
-from ridempc.mpc.controller import LinearMpc, MpcSettings
-from ridempc.mpc.drop import DropDetector
-from ridempc.mpc.flight import DropFlight
-from ridempc.mpc.foot_spread import spread_lines
-from ridempc.mpc.force_filter import ForceFilter
-from ridempc.mpc.handover import (
-    RETURN_DEVIATION,
-    RETURN_DWELL_S,
-    STANDBY_DIVIDER,
-    Handover,
-    share_estimator,
-)
-from ridempc.mpc.lean import Crouch, LeanSteering
-from ridempc.mpc.manoeuvre import (
-    HOLD,
-    REPUSH,
-    REPUSH_BAND,
-    Manoeuvre,
-    ManoeuvreSelector,
-    StateLayout,
-)
-from ridempc.mpc.pairs import check_library_names, load_mpc_pair
-from ridempc.mpc.payload import PayloadEstimator
-from ridempc.mpc.plan_book import PlanBook
+from ridempc.estimation import EstimatedState
+from ridempc.mpc.controller import MpcSettings
+from ridempc.mpc.handover import RETURN_DEVIATION
+from ridempc.mpc.manoeuvre import HOLD, REPUSH, REPUSH_BAND
 from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY, PlanSolver
-from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
 from ridempc.mpc.push_handover import deviation_deferred
-from ridempc.mpc.push_side import PushSide
-from ridempc.mpc.readiness import start_readiness
-from ridempc.mpc.reference import MotionReference
-from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
+from ridempc.mpc.rider_parts import BACKUP_LAW, MPC_DIVIDER, RiderParts
 from ridempc.mpc.solver_process import SolverProcess
-from ridempc.mpc.stages.base import (
-    ControlTick,
-    DriftSource,
-    MpcTick,
-    ProblemShaper,
-    TickObserver,
-    present,
-)
-from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper
+from ridempc.mpc.stages.base import ControlTick, MpcTick
 from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve, build_and_run
-from ridempc.mpc.stages.commands import CommandHorizon
-from ridempc.mpc.stages.deck_roll import deck_stages
-from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observer
-from ridempc.mpc.stages.feet_targets import FeetTargets
-from ridempc.mpc.stages.manoeuvre_choice import ManoeuvreChoice
-from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
-from ridempc.mpc.stages.payload_models import PayloadModels
-from ridempc.mpc.stages.plan_watch import STANDBY_WARMUP_S, PlanWatch
-from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_stages
-from ridempc.mpc.stages.support import contacts_to_feet, foot_support
-from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, PushWatch, handover_triggers
-from ridempc.mpc.stages.turn import TurnSoFar
-from ridempc.mpc.stagger import standby_phase
-from ridempc.mpc.state_map import StateMap, forward_speed
-from ridempc.mpc.swing import ReferenceFeet
-from ridempc.robots.pinocchio_model import build_pinocchio_robot
+from ridempc.mpc.stages.plan_watch import STANDBY_WARMUP_S
+from ridempc.mpc.stages.support import foot_support
+from ridempc.mpc.stages.triggers import HandoverCheck
+from ridempc.mpc.state_map import forward_speed
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
@@ -146,7 +81,6 @@ from ridempc.trajopt.schedule import Contact
 from ridempc.wbc import WbcTargets, to_motor_command
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.targets import WbcOutput
-from ridempc.wbc.torque_lead import TorqueLead
 
 __all__ = [
     "BACKUP_LAW",
@@ -159,20 +93,9 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-MPC_DIVIDER: int = 15  # 500 Hz / 15 = 33.3 Hz ~ the paper's 30 Hz; the MPC step stays 1/30 s
-# The law the ride is handed to when the MPC or its QP fails (ridempc.mpc.handover): the
-# pair's PD baseline, which balances every pair from the same sensors.
-BACKUP_LAW: str = "pd"
 
 
-def _backup(robot: Robot, board: str) -> Controller:
-    """The registry's :data:`BACKUP_LAW` for ``robot`` on ``board``."""
-    from ridempc.controllers.registry import CONTROLLERS  # the registry imports this module
-
-    return CONTROLLERS[BACKUP_LAW](robot, board)
-
-
-class MpcRider(Controller):
+class MpcRider(RiderParts):
     """MPC at 30 Hz over the robot and its board, whole-body QP at 500 Hz.
 
     Args:
@@ -204,210 +127,9 @@ class MpcRider(Controller):
         plan_latency: int | None = None,
         backup: Controller | None = None,
     ) -> None:
-        super().__init__(robot, board)
-        from ridempc.boards import load_board
-
-        self.pair = load_mpc_pair(robot.name, board)
-        stages = self.pair.description.stages  # the pair file's per-pair mechanisms
-        tuning = self.pair.description.wbc
-        # Ticks from the state a solve starts from to the tick its plan takes over: with 1
-        # or more OSQP iterates in a thread beside the loop and the ticks between follow
-        # the previous plan; waited for at that tick, so that a ride does not depend on the
-        # machine (the pair's ``plan_latency`` unless given).
-        latency = self.pair.plan_latency if plan_latency is None else plan_latency
-        if latency < 0 or latency >= MPC_DIVIDER:
-            raise ValueError(f"plan_latency must be 0 to {MPC_DIVIDER - 1} ticks, got {latency}")
-        self.plan_latency = latency
-        # A plan taken up late solved from the state predicted at its take-up (mpc/delay.py),
-        # else from the tick's, its time shifted (the pair's ``predict_start``).
-        self.predicts_start = self.pair.predict_start
-        loaded = load_board(board)
-        n_platforms = len(loaded.params.platform_sites) if loaded is not None else 1
-        self.platform_feet = platform_feet(robot, n_platforms)
-        self.estimator = StateEstimator(
-            robot,
-            platforms=self.platform_feet,
-            support_height=loaded.platform_top if loaded is not None else 0.0,
-        )
-        self.pinocchio = build_pinocchio_robot(robot)
-        self.selector = ManoeuvreSelector(robot.name, board)
-        symmetry = self.pair.symmetry  # each re-push from the side its turn needs
-        self.push_side = (
-            PushSide(symmetry) if symmetry is not None and REPUSH in self.selector.targets else None
-        )
-        first = self.selector.initial()
-        self.mpc = LinearMpc.from_library(
-            robot.name, board, first.library_kind, first.target, settings
-        )
-        # the rider's mass and centre of mass from its stance (ridempc.mpc.payload)
-        self.payload = (
-            PayloadEstimator(robot, self.pinocchio, self.mpc.settings.dt)
-            if stages.payload is not None
-            else None
-        )
-        names = self.mpc.reference.input_names
-        check_library_names(self.pair.description, self.mpc.reference)
-        # Board inputs of the library that this rider does not realise (the pair file's
-        # ``unrealised_inputs``), held at zero in the MPC.
-        unrealised = self.pair.description.mpc.unrealised_inputs
-        pinned = {n: 0.0 for n in unrealised if n in names}
-        self.mpc.fix_inputs({**pinned, **self.mpc.settings.fixed_inputs})
-        # Yaw-rate commands are laid over the reference only where the rider can turn the
-        # board (not the Segway with its knee bar pinned, which the lean turns).
-        self.steers = self.mpc.steers()
-        # A board with a yaw rate that the rider cannot drive (the Segway's): the library
-        # frame turns with its heading (StateMap.follow_sideways).
-        # where each board state is in the MPC's state, by its canonical quantity
-        columns = board_state_columns(self.mpc.reference.state_names, self.pair.board_states)
-        yaw_rates = any(state.quantity == "yaw_rate" for state in columns)
-        self._follows_heading = yaw_rates and not self.steers
-        # A board turned by a bar the legs push (the Segway's knee bar, held at zero in the
-        # plan): the rider crouches to reach it and leans into it (ridempc.mpc.lean).
-        self.crouch = Crouch.of(robot, board)
-        self.lean = LeanSteering() if stages.lean is not None and not self.steers else None
-        # offset-free MPC (mpc/disturbance.py)
-        self.disturbance = disturbance_observer(self.pair, self.mpc.reference.state_names)
-        self.manoeuvre: Manoeuvre = first
-        reference = self.mpc.reference
-        self.layout = StateLayout.from_pair(reference.state_names, self.pair)
-        self.map = StateMap(
-            self.pinocchio, reference.state_names, self.pair.board_states, base=self.pair.base
-        )
-        self.wbc = rider_wbc(robot, board, loaded, self.pinocchio, self.pair, wbc_solver)
-        self._feedforward = tuning.feedforward
-        tau = self.pair.force_time_constant  # the forces the WBC gets, low-passed
-        self.force_filter = ForceFilter(tau) if tau is not None else None
-        self.kp, self.kd = tracking_gains(robot, board, tuning.tracking_gain_scale)
-        self.torque_lead = TorqueLead(robot, self.wbc.settings.dt)  # sent ahead of the delay
-        feet = robot.params.foot_bodies  # the foot of each library contact
-        self._contact_foot = contacts_to_feet(robot.mj_model, feet, reference.contact_names)
-        self._read_plan = PlanReader(
-            self.layout.names,
-            self.layout.base_prefix,
-            reference.force_index,
-            self._contact_foot,
-            len(robot.params.foot_bodies),
-            self._feedforward,
-            self.mpc.settings.dt,
-        )
-        # The library's contacts are the WBC's sites (Cassie's toe lines): the WBC then
-        # applies the MPC's centre of pressure along each foot, not an even share.
-        self._sites_match = tuple(reference.contact_names) == tuple(robot.params.contact_sites)
-        # where each foot stands along its shoe and each shoe's drag, its heading (Hovershoes)
-        shoes = shoe_stages(stages, loaded, self.wbc.model, self.platform_feet, columns)
-        self.shoes, self.shoe_heading, self._shoe_lines, self._shoe_columns = shoes
-        n_feet = len(robot.params.foot_bodies)  # the deck's roll steering and balance
-        deck = deck_stages(self.pair, loaded, columns, self.mpc, n_feet, self.map.com)
-        self.commands = CommandHorizon(  # the commands read over the horizon
-            self,
-            self.mpc.settings,
-            self.pair.roll_lead,
-            self.steers,
-            deck.steer_gain,
-            self.pair.speed_preview,
-        )
-        self.choice = ManoeuvreChoice(  # the manoeuvre the command asks for
-            self.selector, self.mpc, self.layout, self.pair, self.push_side, self.commands
-        )
-        self.roll_drift, self.stance_roll = deck.drift, deck.stance
-        self.feet = ReferenceFeet(
-            self.wbc.model, reference.state_names, self.layout.base_prefix, self.layout.board_pose
-        )
-        self.feet_targets = FeetTargets(self.feet, self.wbc, self.mpc)
-        self._support: tuple[Contact, ...] | None = None  # per foot, this MPC step
-        self._tick = 0
-        self.book = PlanBook(self.force_filter)  # the plan in force (mpc/plan_book.py)
-        self.turn = TurnSoFar()  # the commanded yaw rate integrated over the ride
-        self._hold: MotorCommand | None = None
-        self._wbc_failures = 0  # in all
-        self._hold_reason: str | None = None
-        self._hold_time: float | None = None
-        self._mpc_main_s = 0.0  # [s] the MPC's time in the control loop's own thread
+        super().__init__(robot, board, settings, wbc_solver, plan_latency, backup)
         # where each solve runs and when its plan takes over (mpc/plan_solver.py)
-        self.solver = PlanSolver(latency, self._build_and_run, self._build_in_process)
-        self._sent_reference: MotionReference | None = None  # the last one the build got
-        self._wbc_ms: list[float] = []
-        self._wbc_slack_max = 0.0  # the largest slack the WBC's soft rows took
-        # the platforms falling away under the feet (a step), with the ``drop`` stage
-        self.drop_watch = DropWatch(DropDetector()) if stages.drop is not None else None
-        # the drop ridden by the whole-body QP, the feet after the platforms (``flight``)
-        self.flight = (
-            DropFlight(self.drop_watch, stages.flight.extend_speed, stages.flight.max_extension)
-            if stages.flight is not None
-            else None
-        )
-        self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
-        law = backup if backup is not None else _backup(robot, board)
-        shared = share_estimator(law, self.estimator)  # one filter for both
-        # the backup's standby in full every tick while the MPC is on its first probation, in
-        # the ride's first STANDBY_WARMUP_S: the backup's filters start there from rest, and
-        # at 33 Hz over the first 0.06 s they had not caught up when handed the ride
-        self._standby_every = STANDBY_DIVIDER if shared else 1
-        self.handover = Handover(
-            law,
-            standby_every=1,
-            standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
-        )
-        # the ride starts on the backup until the MPC is ready (mpc/readiness.py)
-        self.readiness = start_readiness(stages.takeover, RETURN_DWELL_S)
-        if self.readiness is not None:
-            self.handover.start_on_backup()
-        self.watch = PlanWatch(self.handover, self.readiness, self.payload, self._standby_every)
-        self._diagnostics: dict[str, float] = {}
-        # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
-        self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass)
-        self.impulse = self.push_watch.observer if self.push_watch is not None else None
-        self.payload_models = (
-            PayloadModels(
-                self.payload,
-                (self.pinocchio.model, self.wbc.model.model),
-                self.map.com,
-                self.layout.names["vz"],
-            )
-            if self.payload is not None
-            else None
-        )
-        self._build_stages()
-
-    def _build_stages(self) -> None:
-        """Every list of stages, each in the order its stages act (one protocol a list,
-        :mod:`ridempc.mpc.stages.base`): where a new stage is added."""
-        shoes = ShoeUpdate(self.shoes) if self.shoes is not None else None
-        self.observers: tuple[TickObserver, ...] = present(
-            self.drop_watch, self.flight, self.payload_models
-        )
-        self.wbc_observers: tuple[TickObserver, ...] = present(shoes, self.push_watch)
-        self.drifts: tuple[DriftSource, ...] = self._drift_sources()
-        self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
-        self.triggers = handover_triggers(self.drop_watch, self.push_watch, self.flight)
-
-    def _drift_sources(self) -> tuple[DriftSource, ...]:
-        """The disturbance observers whose drifts the MPC's rates carry, in the order they
-        are summed: the deck's torque, the payload, the steady disturbance, the lean's."""
-        dt, names = self.mpc.settings.dt, self.layout.names
-        return present(
-            self.roll_drift,
-            self.payload_models,
-            SteadyDrift(self.disturbance, dt) if self.disturbance is not None else None,
-            LeanDrift(self.lean, names["vy"]) if self.lean is not None else None,
-        )
-
-    def _problem_shapers(self) -> tuple[ProblemShaper, ...]:
-        """The problem shapers, in the order they act: the manoeuvre's (coasting, the
-        commanded roll, a re-push's blend, the turn), then the board's (the crouch, the
-        lean, the shoes' lines and drags, the swing's held forces)."""
-        mpc, layout, step = self.mpc, self.layout, self.pair.swing_force_step
-        blend = RepushBlend(mpc, layout)
-        return present(
-            Coasting(layout, blend),
-            RollCommand(mpc, layout),
-            blend,
-            Turn(layout),
-            CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
-            LeanShaper(mpc, layout) if self.lean is not None else None,
-            self._shoe_lines,
-            HeldForces(mpc, step) if step is not None else None,
-        )
+        self.solver = PlanSolver(self.plan_latency, self._build_and_run, self._build_in_process)
 
     def _mapped(self, estimate: EstimatedState) -> EstimatedState:
         """The estimate as the MPC sees it: each Hovershoe's origin on its axis."""
@@ -574,18 +296,7 @@ class MpcRider(Controller):
             self.payload_models.absorb(tick)
         pushing = Contact.GROUND in self.book.contacts  # a foot on the ground goes straight
         steering = balancing or (self.manoeuvre.kind == REPUSH and not pushing)
-        limit = partial(self.stance_roll, tick=tick) if self.stance_roll is not None else None
-        names = self.layout.names
-        roll, turn = self.commands.roll_and_turn(command, now, speed, steering, limit, names)
-        here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
-        if self.shoes is not None:  # the frame follows platform 0 onto its spread line
-            here = spread_lines(here[None, :], self._shoe_columns, command.lateral_offset)[0]
-        yaw_rate = estimate.yaw_rate
-        if self.lean is not None:
-            self.lean.update(now, command.yaw_rate, yaw_rate, speed)
-        carried = self.lean.turn_rate if self.lean is not None else 0.0
-        self._follow_board(mapped, here, turn, now, coasting, carried)
-        x0 = self.turn.unwrapped(self.map.state(mapped), here, self.layout.headings)
+        roll, turn, x0 = self.commanded(tick, command, mapped, t_ref, coasting, steering)
         started = time.perf_counter()
         turned = math.remainder(self.map.frame.yaw - self.book.frame.yaw, 2.0 * math.pi)
         tick = tick._replace(frame_turn=turned)  # the frame has moved onto the board
@@ -692,33 +403,6 @@ class MpcRider(Controller):
             and self.manoeuvre.kind in ("accelerate", REPUSH)
             and t_ref >= float(self.mpc.reference.times[-1])
         )
-
-    def _follow_board(
-        self,
-        estimate: EstimatedState,
-        reference: Array,
-        turn: Array,
-        now: float,
-        coasting: bool,
-        yaw_rate: float,
-    ) -> None:
-        """Integrate the commanded turn and move the library frame onto the board (the
-        ``reference`` state of this tick): across the reference's line (turned by the turn
-        so far), along it by what lies beyond :data:`~ridempc.mpc.state_map.ALONG_SLACK`,
-        and all along it while turning or coasting (the reference's steady ride is not
-        where a coasting board goes); on a board whose heading the frame follows, that
-        heading carried by ``yaw_rate`` [rad/s], the turn the rider is making."""
-        turned = self.turn.advance(now, float(turn[0]))
-        x, y, heading = self.layout.board_pose(reference)
-        along = coasting or bool(np.any(turn)) or turned != 0.0
-        self.map.follow_sideways(
-            estimate,
-            (x, y, heading + turned),
-            along=along,
-            heading=self._follows_heading,
-            yaw_rate=yaw_rate,
-        )
-        self.map.follow_ground(estimate)
 
     def _set_support(self, contacts: tuple[Contact, ...]) -> None:
         """Where each foot is over this MPC step, from the schedule's contacts: on the ground
