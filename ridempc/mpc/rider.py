@@ -24,10 +24,10 @@ there, in the order they act. Every 2 ms (500 Hz) the rider
    in the tick, the solver thread or the solver process
    (:class:`~ridempc.mpc.plan_solver.PlanSolver`), from the state predicted at the plan's
    take-up ``plan_latency`` ticks later (:mod:`ridempc.mpc.delay`);
-3. takes a plan up at its tick (:class:`~ridempc.mpc.plan_book.PlanBook`, the handover's
-   :class:`~ridempc.mpc.stages.plan_watch.PlanWatch`), reads it into whole-body targets
-   (:class:`~ridempc.mpc.plan_targets.PlanReader`; the feet's support and swing,
-   :mod:`~ridempc.mpc.stages.feet_targets`; each shoe's drag as its platform's
+3. takes a plan up at its tick (:class:`~ridempc.mpc.plan_book.PlanBook`, watched by the
+   handover's :class:`~ridempc.mpc.stages.plan_watch.PlanWatch`), reads it into
+   whole-body targets (:class:`~ridempc.mpc.stages.wbc_targets.TargetsFromPlan`: the plan
+   at its age, the feet's support and swing, each shoe's drag as its platform's
    acceleration) and solves the whole-body QP (:class:`~ridempc.wbc.WholeBodyController`);
 4. updates the observers of the QP's output (``wbc_observers``: the shoes' observer, the
    push's watch), asks the **handover triggers** in order (``triggers``,
@@ -43,7 +43,8 @@ the motor commands blended, and handed back once the MPC's plans have solved and
 has stayed near the reference for a while (:mod:`~ridempc.mpc.handover`); each handover is
 in ``summary()``'s ``fallbacks``. With the pair's ``takeover`` stage the ride starts on that
 backup until the MPC is ready (:mod:`~ridempc.mpc.readiness`). Only where the backup too
-has no finite command are the joints held where they are (``safe_hold``).
+has no finite command are the joints held where they are (``safe_hold``). What the ride
+reports (``summary()``, ``diagnostics()``) is in :mod:`~ridempc.mpc.rider_reports`.
 """
 
 from __future__ import annotations
@@ -51,34 +52,30 @@ from __future__ import annotations
 import copy
 import math
 import time
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState
-from ridempc.mpc.controller import MpcSettings
 from ridempc.mpc.handover import RETURN_DEVIATION
 from ridempc.mpc.manoeuvre import HOLD, REPUSH, REPUSH_BAND
-from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY, PlanSolver
+from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
 from ridempc.mpc.push_handover import deviation_deferred
-from ridempc.mpc.rider_parts import BACKUP_LAW, MPC_DIVIDER, RiderParts
-from ridempc.mpc.solver_process import SolverProcess
+from ridempc.mpc.rider_parts import BACKUP_LAW, MPC_DIVIDER
+from ridempc.mpc.rider_reports import RiderReports
 from ridempc.mpc.stages.base import ControlTick, MpcTick
-from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve, build_and_run
+from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve
 from ridempc.mpc.stages.plan_watch import STANDBY_WARMUP_S
 from ridempc.mpc.stages.support import foot_support
 from ridempc.mpc.stages.triggers import HandoverCheck
 from ridempc.mpc.state_map import forward_speed
-from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
 from ridempc.trajopt.schedule import Contact
-from ridempc.wbc import WbcTargets, to_motor_command
+from ridempc.wbc import to_motor_command
 from ridempc.wbc.qp import WbcFailed
 from ridempc.wbc.targets import WbcOutput
 
@@ -95,7 +92,7 @@ __all__ = [
 Array = NDArray[np.float64]
 
 
-class MpcRider(RiderParts):
+class MpcRider(RiderReports):
     """MPC at 30 Hz over the robot and its board, whole-body QP at 500 Hz.
 
     Args:
@@ -104,6 +101,8 @@ class MpcRider(RiderParts):
         settings: MPC settings.
         wbc_solver: The whole-body QP's solver (:data:`~ridempc.wbc.settings.SOLVERS`);
             None: the registry's (:data:`~ridempc.solvers.QP_KINDS`).
+        plan_latency: Ticks from the state a solve starts from to its plan's take-up,
+            0 to ``MPC_DIVIDER - 1`` (:mod:`~ridempc.mpc.plan_solver`); None: the pair's.
         backup: The law the ride is handed to when the MPC fails
             (:mod:`~ridempc.mpc.handover`); None: the registry's :data:`BACKUP_LAW` for
             the pair.
@@ -111,25 +110,10 @@ class MpcRider(RiderParts):
     Raises:
         UnknownNameError: No MPC for this robot-board pair.
         ConfigError: Its library is missing or corrupt, or an unknown ``wbc_solver``.
+        ValueError: ``plan_latency`` outside 0 to ``MPC_DIVIDER - 1``.
     """
 
     rate_hz = 500.0
-    # Whether the solver process sends each problem back with its plan (the bench keeps
-    # them; the ride needs the plan only).
-    keeps_problems: bool = False
-
-    def __init__(
-        self,
-        robot: Robot,
-        board: str,
-        settings: MpcSettings | None = None,
-        wbc_solver: str | None = None,
-        plan_latency: int | None = None,
-        backup: Controller | None = None,
-    ) -> None:
-        super().__init__(robot, board, settings, wbc_solver, plan_latency, backup)
-        # where each solve runs and when its plan takes over (mpc/plan_solver.py)
-        self.solver = PlanSolver(self.plan_latency, self._build_and_run, self._build_in_process)
 
     def _mapped(self, estimate: EstimatedState) -> EstimatedState:
         """The estimate as the MPC sees it: each Hovershoe's origin on its axis."""
@@ -338,38 +322,9 @@ class MpcRider(RiderParts):
             self._adopt(pending, built)
         self._mpc_main_s += time.perf_counter() - started
 
-    @property
-    def off_tick(self) -> str:
-        """Where a late plan's solve runs (:data:`~ridempc.mpc.plan_solver.OFF_TICK`)."""
-        return self.solver.off_tick
-
-    @off_tick.setter
-    def off_tick(self, where: str) -> None:
-        self.solver.off_tick = where
-
-    @property
-    def _worker(self) -> SolverProcess[BuildInputs, Built] | None:
-        return self.solver.worker
-
-    @property
-    def _pending(self) -> PendingSolve | None:
-        return self.solver.pending
-
     def close(self) -> None:
         """End the MPC's solver process, if one was started (at the end of a ride)."""
         self.solver.close()
-
-    def _build_and_run(self, inputs: BuildInputs) -> Built:
-        """The MPC problem of one tick built from ``inputs``, shaped by the rider's
-        problem shapers in order (:attr:`shapers`) and solved
-        (:func:`~ridempc.mpc.stages.build.build_and_run`)."""
-        return build_and_run(self.mpc, self.shapers, inputs)
-
-    def _build_in_process(self, inputs: BuildInputs) -> Built:
-        """:meth:`_build_and_run` in the solver process, its reply without the problem
-        (a few hundred kB to send and read back) unless ``keeps_problems``."""
-        built = self._build_and_run(inputs)
-        return built if self.keeps_problems else built._replace(problem=None)
 
     def _adopt_pending(self, solve: PendingSolve) -> None:
         """The pending ``solve``'s plan taken up, its tick come (waiting for it if the
@@ -417,6 +372,7 @@ class MpcRider(RiderParts):
         self.estimator.set_support(ground, swinging)
 
     def _speed(self, estimate: EstimatedState) -> float:
+        """The board's forward speed [m/s] (on flat ground, the base's horizontal speed)."""
         if estimate.boards:
             return forward_speed(estimate.boards[0])
         return float(np.linalg.norm(estimate.base_velocity[:2]))
@@ -424,31 +380,9 @@ class MpcRider(RiderParts):
     def _wbc_tick(self, estimate: EstimatedState, now: float) -> tuple[MotorCommand, WbcOutput]:
         """The whole-body QP's motor command for the plan in force at ``now`` [s], and its
         output."""
-        plan = self.book.plan
-        assert plan is not None
-        wanted = self._read_plan(plan, self.book.frame, self.book.age(now))
         assert self._support is not None  # set by the MPC tick, which runs first
         t_ref = self.manoeuvre.reference_time(now)
-        feet = self.feet_targets(self._support, t_ref, estimate, self.book.frame)
-        swing_acceleration = None
-        if self.flight is not None and self.flight.flying:  # no foot stands: mpc/flight.py
-            feet, swing_acceleration = self.flight.feet(feet, estimate)
-        targets = WbcTargets(
-            position=wanted.position,
-            orientation=wanted.orientation,
-            contact=feet.contact,
-            forces=wanted.forces,
-            velocity=wanted.velocity,
-            acceleration=wanted.acceleration,
-            angular_velocity=wanted.angular_velocity,
-            angular_acceleration=wanted.angular_acceleration,
-            site_forces=wanted.site_forces if self._sites_match else None,
-            swing_position=feet.swing,
-            swing_velocity=feet.swing_velocity,
-            swing_acceleration=swing_acceleration,
-            posture=feet.posture,
-            board_acceleration=self.shoes.drift(estimate.boards) if self.shoes is not None else (),
-        )
+        targets = self.targets(self.book, self._support, t_ref, estimate, now)
         out = self.wbc.solve(estimate, targets)
         self._wbc_ms.append(out.model_ms + out.build_ms + out.solve_ms)
         slack = self.wbc.last_solution.slack if self.wbc.last_solution is not None else 0.0
@@ -456,59 +390,3 @@ class MpcRider(RiderParts):
         self._diagnostics.update(wbc_ms=self._wbc_ms[-1], wbc_slack=slack)
         torque = self.torque_lead(now, out.torque)
         return to_motor_command(out, self.kp, self.kd, torque=torque), out
-
-    # ------------------------------------------------------------------ reports
-
-    def estimate(self) -> EstimatedState | None:
-        return self.estimator.state
-
-    def diagnostics(self) -> dict[str, float]:
-        return dict(self._diagnostics)
-
-    @property
-    def mpc_tick_ms(self) -> tuple[float, ...]:
-        """Each MPC tick's time so far [ms]: building the problem and solving it (the
-        solve's own time, not the ticks it runs alongside)."""
-        return tuple(self.book.ms)
-
-    @property
-    def mpc_loop_seconds(self) -> float:
-        """The MPC's time in the control loop's thread so far [s]: building, starting and
-        finishing its solves, and waiting for one still running when its tick comes."""
-        return self._mpc_main_s
-
-    def summary(self) -> dict[str, Any]:
-        """Solve times, fallbacks and the safe hold, for ``summary.json``: the MPC's QP
-        (``mpc_solve_ms``: its update and OSQP's solve, as ``ridempc bench`` times it) and
-        its whole tick (``mpc_tick_ms``: building the problem too), median and p99 [ms]."""
-        out: dict[str, Any] = {}
-        for key, values in (
-            ("mpc_solve_ms", self.book.qp_ms),
-            ("mpc_tick_ms", self.book.ms),
-            ("wbc_solve_ms", self._wbc_ms),
-        ):
-            if values:
-                ms = np.asarray(values)
-                out[key] = {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}
-        out["mpc_solves"] = len(self.book.ms)
-        out["speed_preview_s"] = self.commands.speed_preview_s()
-        out["mpc_fallbacks"] = self.book.failures
-        out["wbc_failures"] = self._wbc_failures
-        out["wbc_cold_retries"] = self.wbc.qp.cold_retries
-        out["wbc_daqp_solves"] = self.wbc.qp.fallbacks
-        out["wbc_elastic_solves"] = self.wbc.qp.elastic_solves
-        out["wbc_slack_max"] = self._wbc_slack_max
-        out["fallbacks"] = self.handover.summary()
-        out["mpc_takeover_s"] = 0.0 if self.readiness is None else self.handover.takeover_s
-        if self.readiness is not None:
-            out["takeover"] = self.readiness.summary()
-        out["deviation_divergent_max"] = self.watch.divergence.peak
-        out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
-        out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
-        out["flights_s"] = list(self.flight.starts) if self.flight is not None else None
-        out["safe_hold"] = (
-            None
-            if self._hold_reason is None
-            else {"time_s": self._hold_time, "reason": self._hold_reason}
-        )
-        return out

@@ -25,14 +25,17 @@ from ridempc.mpc.manoeuvre import REPUSH, Manoeuvre, ManoeuvreSelector, StateLay
 from ridempc.mpc.pairs import check_library_names, load_mpc_pair
 from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.plan_book import PlanBook
+from ridempc.mpc.plan_solver import PlanSolver
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.platform_feet import platform_feet
 from ridempc.mpc.push_side import PushSide
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
+from ridempc.mpc.solver_process import SolverProcess
 from ridempc.mpc.stages.base import DriftSource, ProblemShaper, TickObserver, present
 from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper
+from ridempc.mpc.stages.build import BuildInputs, Built, PendingSolve, build_and_run
 from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.mpc.stages.deck_roll import deck_stages
 from ridempc.mpc.stages.drifts import LeanDrift, SteadyDrift, disturbance_observer
@@ -46,6 +49,7 @@ from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_stages
 from ridempc.mpc.stages.support import contacts_to_feet
 from ridempc.mpc.stages.triggers import DropWatch, PushWatch, handover_triggers
 from ridempc.mpc.stages.turn import TurnSoFar
+from ridempc.mpc.stages.wbc_targets import TargetsFromPlan
 from ridempc.mpc.stagger import standby_phase
 from ridempc.mpc.state_map import StateMap
 from ridempc.mpc.swing import ReferenceFeet
@@ -73,6 +77,10 @@ def _backup(robot: Robot, board: str) -> Controller:
 class RiderParts(Controller):
     """The MPC rider's parts for ``robot`` on ``board`` (arguments as
     :class:`~ridempc.mpc.rider.MpcRider`'s), and its stages listed by protocol."""
+
+    # Whether the solver process sends each problem back with its plan (the bench keeps
+    # them; the ride needs the plan only).
+    keeps_problems: bool = False
 
     def __init__(
         self,
@@ -224,6 +232,9 @@ class RiderParts(Controller):
             if stages.flight is not None
             else None
         )
+        self.targets = TargetsFromPlan(  # the whole-body QP's targets from the plan in force
+            self._read_plan, self.feet_targets, self.flight, self.shoes, self._sites_match
+        )
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
@@ -241,6 +252,8 @@ class RiderParts(Controller):
         if self.readiness is not None:
             self.handover.start_on_backup()
         self.watch = PlanWatch(self.handover, self.readiness, self.payload, self._standby_every)
+        # where each solve runs and when its plan takes over (mpc/plan_solver.py)
+        self.solver = PlanSolver(latency, self._build_and_run, self._build_in_process)
         self._diagnostics: dict[str, float] = {}
         # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
         self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass)
@@ -256,6 +269,35 @@ class RiderParts(Controller):
             else None
         )
         self._build_stages()
+
+    def _build_and_run(self, inputs: BuildInputs) -> Built:
+        """The MPC problem of one tick built from ``inputs``, shaped by the rider's
+        problem shapers in order (:attr:`shapers`) and solved
+        (:func:`~ridempc.mpc.stages.build.build_and_run`)."""
+        return build_and_run(self.mpc, self.shapers, inputs)
+
+    def _build_in_process(self, inputs: BuildInputs) -> Built:
+        """:meth:`_build_and_run` in the solver process, its reply without the problem
+        (a few hundred kB to send and read back) unless ``keeps_problems``."""
+        built = self._build_and_run(inputs)
+        return built if self.keeps_problems else built._replace(problem=None)
+
+    @property
+    def off_tick(self) -> str:
+        """Where a late plan's solve runs (:data:`~ridempc.mpc.plan_solver.OFF_TICK`)."""
+        return self.solver.off_tick
+
+    @off_tick.setter
+    def off_tick(self, where: str) -> None:
+        self.solver.off_tick = where
+
+    @property
+    def _worker(self) -> SolverProcess[BuildInputs, Built] | None:
+        return self.solver.worker
+
+    @property
+    def _pending(self) -> PendingSolve | None:
+        return self.solver.pending
 
     def _build_stages(self) -> None:
         """Every list of stages, each in the order its stages act (one protocol a list,
