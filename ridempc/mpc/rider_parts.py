@@ -293,10 +293,12 @@ class RiderParts(Controller):
 
     @property
     def _worker(self) -> SolverProcess[BuildInputs, Built] | None:
+        """The solver process, if one was started (the bench reads its problems back)."""
         return self.solver.worker
 
     @property
     def _pending(self) -> PendingSolve | None:
+        """The solve under way until its plan's take-up, if any."""
         return self.solver.pending
 
     def _build_stages(self) -> None:
