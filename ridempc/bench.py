@@ -311,7 +311,8 @@ def _profiled(rider: Any, profiler: PartProfiler) -> None:
         (rider, "_adopt_pending", "mpc"),
     ):
         setattr(owner, method, profiler.wrap(getattr(owner, method), part))
-    rider._build_and_run = profiler.wrap_kind(rider._build_and_run, "mpc_build")
+    solver = rider.solver  # the build and solve the plan solver runs, wherever it runs them
+    solver._build = profiler.wrap_kind(solver._build, "mpc_build")
     update = rider.update
 
     def kind_then_update(sensors: Any, command: Any) -> Any:
