@@ -80,6 +80,7 @@ from ridempc.boards.canonical import board_state_columns
 from ridempc.controllers.base import Controller
 from ridempc.errors import RidempcError
 from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.mpc.backup_reach import lend_drop_watch
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.delay import predicted_start
 from ridempc.mpc.divergence import DivergentDeviation, Probation
@@ -372,6 +373,7 @@ class MpcRider(Controller):
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
+        lend_drop_watch(law, self.drop_watch)  # its legs reach after a drop, not a push
         # the backup's standby in full every tick while the MPC is on its first probation, in
         # the ride's first STANDBY_WARMUP_S: the backup's filters start there from rest, and
         # at 33 Hz over the first 0.06 s they had not caught up when handed the ride
