@@ -57,11 +57,10 @@ On flat ground no shin relaxes and the law above is the paper's.
 Beside the MPC, as its backup, the PD is lent the rider's drop watch (:attr:`shoes_falling`,
 :mod:`ridempc.mpc.backup_reach`): a shin also relaxes when a push tips the rider onto the
 other shoe, and the MPC, leaning against the push before it hands the ride over, holds that
-foot unloaded longer than the PD's own ride does; its leg then reaches 6-10 cm down after a
-shoe that never fell (2.7-8.9 cm in the PD's own rides of the same pushes), and the rider,
-standing on one long leg, falls. So lent a witness, a leg reaches down only once the
-witness has told a drop since the feet were last both loaded; riding alone (no witness),
-the PD is the paper's.
+foot unloaded longer than the PD's own ride does, so that its leg reaches down, up to its
+whole stroke, after a shoe that never fell. So lent a witness, a leg reaches down only once
+the witness has told a drop since the feet were last both loaded; riding alone (no
+witness), the PD is the paper's.
 
 The controller runs the state estimator every tick with one platform per foot (left foot
 on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Gains:
