@@ -744,7 +744,7 @@ class MpcRider(Controller):
         self._divergence.update(solve.time, built.deviation, self._com_height, riding)
         self._divergence.expect(built.expected)
         if riding:
-            settled = not plan.fallback and built.deviation <= RETURN_DEVIATION
+            settled = not plan.fallback and self._divergence.settled(RETURN_DEVIATION)
             self._probation.update(solve.time, settled, RETURN_DWELL_S)
         else:
             self._probation.restart()
