@@ -73,11 +73,13 @@ class DivergentDeviation:
         self._time = self._expected = None
         self.rate = 0.0
 
-    def settled(self, bound: float) -> bool:
+    def settled(self, bound: float, deviation: float, by_prediction: bool = True) -> bool:
         """Whether :math:`\\xi_d \\le` ``bound`` [-]: the state near its reference *and*
         the plan's one-step prediction of it holding (the model fits the rider), the test
-        of :class:`Probation` and of a return."""
-        return self.value <= bound
+        of :class:`Probation` and of a return; with ``by_prediction`` False, the
+        ``deviation`` [-] alone (a pair whose divergence does not settle standing still:
+        the Segway's knee bar carries weight the feet's model does not see)."""
+        return (self.value if by_prediction else deviation) <= bound
 
     def expect(self, deviation: float) -> None:
         """The deviation [-] the plan just solved predicts for the next MPC tick."""
