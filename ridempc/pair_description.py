@@ -205,6 +205,10 @@ class TakeoverStage(_Frozen):
         le=0.5, description="Largest change of the centre of mass's offset over it [m]."
     )
     longest_wait: Positive = Field(le=60.0, description="The MPC takes over by then [s].")
+    by_prediction: bool = Field(
+        default=False,
+        description="The MPC is proven (off probation) only once its plans' predictions hold.",
+    )
 
 
 class FlightStage(_Frozen):

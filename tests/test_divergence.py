@@ -69,3 +69,29 @@ def test_probation_ends_after_a_dwell_fit_and_restarts_on_a_return() -> None:
     assert probation.update(1.0, False, 0.5)  # once proven, until restarted
     probation.restart()
     assert not probation.proven
+
+
+def test_a_model_missing_every_prediction_is_not_proven_within_the_band() -> None:
+    """A wrong model (the board's firmware off its parameters): the deviation stays within
+    the return band (0.7), but every plan's one-step prediction (0.5) misses it by the same
+    margin, 6/s; the rider is not settled and the MPC stays on probation. The same level
+    predicted by its plans settles and is proven after the dwell."""
+    for expected, proven in ((0.5, False), (0.7, True)):
+        divergence, probation = DivergentDeviation(), Probation()
+        for k in range(40):  # 1.3 s, beyond the 0.5 s dwell
+            divergence.update(k * STEP, 0.7, HEIGHT)
+            divergence.expect(expected)
+            probation.update(k * STEP, divergence.settled(1.0, 0.7), 0.5)
+        assert divergence.value > 0.7 if not proven else divergence.value == pytest.approx(0.7)
+        assert probation.proven is proven
+
+
+def test_without_the_prediction_the_level_alone_settles() -> None:
+    """A pair that proves its MPC by the level alone (``by_prediction`` false) is settled
+    within the band whatever its plans predicted; by prediction, not."""
+    divergence = DivergentDeviation()
+    for k in range(10):
+        divergence.update(k * STEP, 0.7, HEIGHT)
+        divergence.expect(0.5)  # each plan expects less than it gets: 6/s of surprise
+    assert divergence.settled(1.0, 0.7, by_prediction=False)
+    assert not divergence.settled(1.0, 0.7)

@@ -92,12 +92,24 @@ def test_blend_and_deviation() -> None:
 
 
 def test_the_dwell_doubles_at_each_further_handover() -> None:
-    handover = Handover(_Backup(), dwell_s=0.1)  # type: ignore[arg-type]
+    handover = Handover(_Backup(), dwell_s=0.1, returns=2)  # type: ignore[arg-type]
     _run(handover, 100, 0, range(10, 11))  # back at tick 61
     assert handover.dwell() == pytest.approx(0.1) and not handover.on_backup
     _run(handover, 200, 100, range(110, 111))
     assert len(handover.summary()) == 2 and handover.dwell() == pytest.approx(0.2)
     assert handover.summary()[1]["duration_s"] == pytest.approx(0.202)  # one tick, the dwell
+
+
+def test_after_its_returns_the_backup_keeps_the_ride() -> None:
+    """A primary handed over again after its one return (an error that stays within the
+    ride) is not given the ride back, however long it is fit."""
+    handover = Handover(_Backup(), dwell_s=0.1, returns=1)  # type: ignore[arg-type]
+    _run(handover, 100, 0, range(10, 11))  # back at tick 61: the one return
+    assert not handover.on_backup
+    sent = _run(handover, 1000, 100, range(110, 111))  # fit for 1.8 s after the second
+    assert handover.on_backup and handover.dwell() == float("inf")
+    assert all(c.torque[0] == 1.0 for c in sent[-100:])  # the backup's command only
+    assert handover.summary()[1]["duration_s"] is None
 
 
 def test_in_standby_the_backup_runs_on_its_first_tick_then_every_nth() -> None:

@@ -152,3 +152,12 @@ def test_cassie_starts_on_the_pd_and_the_mpc_takes_over_once_settled() -> None:
     assert summary["takeover"]["reason"] == SETTLED
     assert RULE.dwell <= summary["mpc_takeover_s"] < 1.2
     assert summary["fallbacks"] == [] and not rider.handover.on_backup
+
+
+def test_the_pair_asks_for_the_proof_by_prediction() -> None:
+    """``by_prediction`` is off unless the pair's takeover asks for it."""
+    base = {"window": 0.3, "mass_change": 0.05, "shift_change": 0.005, "longest_wait": 2.0}
+    plain = start_readiness(TakeoverStage(**base), 0.5)
+    asked = start_readiness(TakeoverStage(**base, by_prediction=True), 0.5)
+    assert plain is not None and not plain.rule.by_prediction
+    assert asked is not None and asked.rule.by_prediction

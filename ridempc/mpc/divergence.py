@@ -73,6 +73,14 @@ class DivergentDeviation:
         self._time = self._expected = None
         self.rate = 0.0
 
+    def settled(self, bound: float, deviation: float, by_prediction: bool = True) -> bool:
+        """Whether :math:`\\xi_d \\le` ``bound`` [-]: the state near its reference *and*
+        the plan's one-step prediction of it holding (the model fits the rider), the test
+        of :class:`Probation` and of a return; with ``by_prediction`` False, the
+        ``deviation`` [-] alone (a pair whose divergence does not settle standing still:
+        the Segway's knee bar carries weight the feet's model does not see)."""
+        return (self.value if by_prediction else deviation) <= bound
+
     def expect(self, deviation: float) -> None:
         """The deviation [-] the plan just solved predicts for the next MPC tick."""
         self._expected = deviation
@@ -95,8 +103,12 @@ class DivergentDeviation:
 
 class Probation:
     """Whether the MPC has yet to show that its model holds the rider: from the ride's
-    start, and again from each return to it, until it has been fit (its deviation within
-    the return band, :data:`~ridempc.mpc.handover.RETURN_DEVIATION`) for a dwell.
+    start, and again from each return to it, until it has been fit (its divergent
+    deviation within the return band, :data:`~ridempc.mpc.handover.RETURN_DEVIATION`,
+    :meth:`DivergentDeviation.settled`) for a dwell. The level alone is not enough: a
+    model that is wrong (the board's firmware or tyres off its parameters) holds the state
+    within the band for a while, each plan's prediction missed by the same margin, while
+    the error it feeds grows; only a prediction that holds shows the model fits.
 
     The lead of :class:`DivergentDeviation` hands over on the growth a plan did not expect;
     that is the model failing only where nothing else acts on the rider. Once the MPC has

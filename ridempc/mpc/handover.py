@@ -5,7 +5,7 @@ its state stays near its reference. When one of them fails, the ride is handed t
 *backup* law that balances the same robot on the same board from the same sensors (the
 pair's PD baseline, :data:`ridempc.controllers.registry.CONTROLLERS`), and handed back
 once the tracking controller has been *fit* again for :data:`RETURN_DWELL_S` (doubled at
-each further handover, :meth:`Handover.dwell`):
+each further handover, :meth:`Handover.dwell`), at most :data:`RETURNS` times a ride:
 
 .. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
           \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
@@ -68,6 +68,7 @@ __all__ = [
     "HANDOVER_DEVIATION",
     "RETURN_DEVIATION",
     "RETURN_DWELL_S",
+    "RETURNS",
     "STANDBY_DIVIDER",
     "Fallback",
     "POSTURE_FADE_S",
@@ -93,6 +94,11 @@ POSTURE_FADE_S: float = 0.5
 # MPC solves in a row near the reference, so that one good solve in a fall, or a rider at
 # the edge of the primary's region, does not hand the ride back and forth.
 RETURN_DWELL_S: float = 0.5
+# [-] how many times a ride the primary takes the ride back after a handover: once, after
+# a transient it could not ride (a push, a start's sway); a second handover shows an error
+# that stays (the rider's or the board's parameters, constant within a ride) and that its
+# model met again, so the backup, which needs no model, keeps the ride.
+RETURNS: int = 1
 # [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
 # beyond which its linear model no longer holds and the ride is handed over: 1.7 times the
 # largest the MPC reached in the library's manoeuvres (1.40-1.75: Segway push and
@@ -177,6 +183,7 @@ class Handover:
         backup: The backup law.
         blend_s: :math:`T_{blend}` [s].
         dwell_s: How long the primary must be fit before it rides again [s].
+        returns: How many times a ride the primary rides again after a handover.
         standby_every: While the primary rides, the backup runs at every this many ticks
             (1: every tick, as it must with an estimator of its own); half a period after
             the first, off the ticks a primary with a slower loop of its own starts from.
@@ -196,8 +203,10 @@ class Handover:
         standby_every: int = 1,
         standby_phase: int | None = None,
         fade_s: float = POSTURE_FADE_S,
+        returns: int = RETURNS,
     ) -> None:
         self.backup = backup
+        self.returns = returns
         self.fade_s = fade_s
         self._fade: PostureFade | None = None  # the posture's offset at the last handover
         self.standby_every = standby_every
@@ -222,7 +231,10 @@ class Handover:
     def dwell(self) -> float:
         """How long the primary must be fit before it rides again [s]: :attr:`dwell_s`,
         doubled at each handover after the first, so that a primary that keeps failing
-        (a model error it cannot absorb) rides less and less."""
+        (a model error it cannot absorb) rides less and less; infinite once it has taken
+        the ride back :attr:`returns` times (it stays on the backup)."""
+        if len(self.fallbacks) > self.returns:
+            return math.inf
         return self.dwell_s * 2.0 ** max(len(self.fallbacks) - 1, 0)
 
     @property

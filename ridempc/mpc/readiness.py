@@ -91,12 +91,17 @@ class StartRule:
         tolerances: Each estimate's largest change over the window (its units).
         dwell: How long the rider must stay in the return band [s].
         longest_wait: When the MPC takes over whatever its estimates [s].
+        by_prediction: Whether, once it rides, the MPC is proven only by its plans'
+            one-step predictions holding as well as its state near its reference
+            (:meth:`~ridempc.mpc.divergence.DivergentDeviation.settled`): a model that
+            had to earn the ride keeps it on the same proof.
     """
 
     window: float
     tolerances: tuple[float, ...]
     dwell: float
     longest_wait: float
+    by_prediction: bool = False
 
 
 class StartReadiness:
@@ -187,4 +192,5 @@ def start_readiness(stage: TakeoverStage | None, dwell: float) -> StartReadiness
     if stage is None:
         return None
     tolerances = (stage.mass_change, stage.shift_change, stage.shift_change)
-    return StartReadiness(StartRule(stage.window, tolerances, dwell, stage.longest_wait))
+    rule = StartRule(stage.window, tolerances, dwell, stage.longest_wait, stage.by_prediction)
+    return StartReadiness(rule)

@@ -59,7 +59,10 @@ class PlanWatch:
         self.divergence.update(time, built.deviation, com_height, riding)
         self.divergence.expect(built.expected)
         if riding:
-            settled = not plan.fallback and built.deviation <= RETURN_DEVIATION
+            proof = self.readiness is not None and self.readiness.rule.by_prediction
+            settled = not plan.fallback and self.divergence.settled(
+                RETURN_DEVIATION, built.deviation, proof
+            )
             self.probation.update(time, settled, RETURN_DWELL_S)
         else:
             self.probation.restart()
