@@ -116,6 +116,7 @@ from ridempc.mpc.push_side import PushSide
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
+from ridempc.mpc.slope_trim import SlopeTrim
 from ridempc.mpc.solver_process import Reply, SolverProcess, forks
 from ridempc.mpc.solver_thread import SolverThread
 from ridempc.mpc.stages.base import (
@@ -319,6 +320,7 @@ class MpcRider(Controller):
         # where each foot stands along its shoe and each shoe's drag, its heading (Hovershoes)
         shoes = shoe_stages(stages, loaded, self.wbc.model, self.platform_feet, columns)
         self.shoes, self.shoe_heading, self._shoe_lines, self._shoe_columns = shoes
+        self._slope_trim = self.shoes is not None and stages.slope_trim is not None
         n_feet = len(robot.params.foot_bodies)  # the deck's roll steering and balance
         deck = deck_stages(self.pair, loaded, columns, self.mpc, n_feet, self.map.com)
         self.commands = CommandHorizon(  # the commands read over the horizon
@@ -438,6 +440,7 @@ class MpcRider(Controller):
             CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
             LeanShaper(mpc, layout) if self.lean is not None else None,
             self._shoe_lines,
+            SlopeTrim(layout, self._shoe_columns) if self._slope_trim else None,
             HeldForces(mpc, step) if step is not None else None,
         )
 
@@ -609,6 +612,9 @@ class MpcRider(Controller):
         names = self.layout.names
         roll, turn = self.commands.roll_and_turn(command, now, speed, steering, limit, names)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
+        if self.shoes is not None and self._slope_trim:  # a slope's lost speed: mpc/slope_trim.py
+            riding, slopes = not self.handover.on_backup, self.shoes.slopes.angles
+            self.shoes.trim.update(now, command.velocity, rider_speed, slopes, riding)
         if self.shoes is not None:  # the frame follows platform 0 onto its spread line
             here = spread_lines(here[None, :], self._shoe_columns, command.lateral_offset)[0]
         yaw_rate = estimate.yaw_rate
