@@ -50,8 +50,9 @@ GATE: float = math.radians(3.0)
 # 0.5 s: the library's 0.8 s per m/s plus its lean), so the trim does not ring with it;
 # short against the 6 s a ride spends on a 3 m slope.
 TIME_CONSTANT: float = 1.0
-# [m/s] the trim at most: 60 % of the commanded 0.5 m/s, the error a fall-free slope can
-# leave; a larger error is a fall under way, which the trim must not wind up on.
+# [m/s] the trim at most: within the 0.5 m/s between the library's speeds (0.5, 1.0, 1.5), so a
+# trimmed reference stays within a step of the library's; twice the steady error measured down
+# 13 deg (0.15-0.17 m/s).
 LIMIT: float = 0.3
 # [m/s] a speed error larger than this is a transient (a crest's run-off, a push), which
 # the plan rides out, not the slope's steady offset: the manoeuvres' own band for a new speed
@@ -99,7 +100,7 @@ class SlopeSpeedTrim:
             wanted: The commanded speed [m/s].
             speed: The rider's forward speed [m/s] (her centre of mass's).
             slopes: The slope under each platform [rad] (positive uphill).
-            riding: Whether the MPC rides (else the trim fades: the backup's speed is not
+            riding: Whether the MPC rides (else the trim is held: the backup's speed is not
                 the plan's).
         """
         dt = 0.0 if self._time is None else max(0.0, time - self._time)
