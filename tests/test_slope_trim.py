@@ -11,7 +11,15 @@ import numpy as np
 import pytest
 
 from ridempc.mpc.manoeuvre import StateLayout
-from ridempc.mpc.slope_trim import BAND, GATE, LIMIT, TIME_CONSTANT, SlopeSpeedTrim, SlopeTrim
+from ridempc.mpc.slope_trim import (
+    BAND,
+    GATE,
+    HOLD,
+    LIMIT,
+    TIME_CONSTANT,
+    SlopeSpeedTrim,
+    SlopeTrim,
+)
 
 DOWN_13 = [-math.radians(13.0)] * 2  # [rad] both shoes on slope-down-13's incline
 STEP = 1.0 / 30.0  # [s] the MPC's tick
@@ -33,9 +41,23 @@ def test_level_ground_leaves_the_reference_alone():
     assert trim.per_slope == 0.0
 
 
-def test_a_steady_error_on_a_slope_is_integrated_at_its_rate():
+def on_the_slope(trim: SlopeSpeedTrim, slopes=DOWN_13) -> None:
+    """Ride ``trim`` onto ``slopes`` with no speed error until it holds them for a slope."""
+    trim.update(0.0 if trim._time is None else trim._time, 0.5, 0.5, slopes)
+    ride(trim, HOLD + STEP, 0.5, 0.5, slopes)
+
+
+def test_a_slope_read_for_less_than_its_hold_is_none():
     trim = SlopeSpeedTrim()
     trim.update(0.0, 0.5, 0.4, DOWN_13)
+    assert ride(trim, HOLD - 2 * STEP, 0.5, 0.4, DOWN_13) == 0.0  # a step's edge, a bump
+    assert ride(trim, STEP, 0.5, 0.4, [0.0, 0.0]) == 0.0
+    assert trim.per_slope == 0.0
+
+
+def test_a_steady_error_on_a_slope_is_integrated_at_its_rate():
+    trim = SlopeSpeedTrim()
+    on_the_slope(trim)
     value = ride(trim, 1.0, 0.5, 0.4, DOWN_13)
     # (v_cmd - v) / T over 1 s, whatever the slope's steepness
     assert value == pytest.approx(0.1 * 1.0 / TIME_CONSTANT, rel=1e-9)
@@ -44,23 +66,24 @@ def test_a_steady_error_on_a_slope_is_integrated_at_its_rate():
 
 def test_the_trim_is_bounded():
     trim = SlopeSpeedTrim()
-    trim.update(0.0, 0.5, 0.3, DOWN_13)
+    on_the_slope(trim)
     assert ride(trim, 30.0, 0.5, 0.3, DOWN_13) == pytest.approx(LIMIT)
 
 
 def test_transients_and_the_backups_ride_are_not_integrated():
     trim = SlopeSpeedTrim()
-    trim.update(0.0, 0.5, 0.5, DOWN_13)
+    on_the_slope(trim)
     assert ride(trim, 1.0, 0.5, 0.5 - 1.2 * BAND, DOWN_13) == 0.0  # a crest's run-off
     assert ride(trim, 1.0, 0.5, 0.4, DOWN_13, riding=False) == 0.0
 
 
 def test_the_trim_goes_with_the_slope_and_comes_back_with_it():
     trim = SlopeSpeedTrim()
-    trim.update(0.0, 0.5, 0.4, DOWN_13)
+    on_the_slope(trim)
     held = ride(trim, 1.0, 0.5, 0.4, DOWN_13)
     assert ride(trim, 0.1, 0.5, 0.6, [0.0, 0.0]) == 0.0  # the slope's end: gone at once
-    assert ride(trim, STEP, 0.5, 0.5, DOWN_13) == pytest.approx(held)  # the same slope again
+    on_the_slope(trim)  # the same slope again, held for its hold
+    assert trim.value == pytest.approx(held)
     # half the slope's sine, half the trim (a gentler slope's pull)
     gentle = [math.asin(0.5 * math.sin(DOWN_13[0]))] * 2
     assert ride(trim, STEP, 0.5, 0.5, gentle) == pytest.approx(0.5 * held)
@@ -68,7 +91,7 @@ def test_the_trim_goes_with_the_slope_and_comes_back_with_it():
 
 def test_at_rest_there_is_no_trim():
     trim = SlopeSpeedTrim()
-    trim.update(0.0, 0.5, 0.4, DOWN_13)
+    on_the_slope(trim)
     ride(trim, 1.0, 0.5, 0.4, DOWN_13)
     assert ride(trim, STEP, 0.0, 0.0, DOWN_13) == 0.0
 

@@ -9,8 +9,8 @@ under a commanded 0.5 m/s and stays there. Whatever the model misses, a steady s
 on a slope is taken out, as in offset-free tracking, by an integral of it laid over the
 reference. The error a slope leaves grows with its pull, :math:`\\propto \\sin\\alpha`, so what
 is integrated is the trim per unit of the slope's sine: while the slope :math:`\\hat\\alpha`
-estimated under the platforms (:mod:`ridempc.mpc.slope`) is steeper than ``GATE`` and the
-MPC rides,
+estimated under the platforms (:mod:`ridempc.mpc.slope`) has been steeper than ``GATE`` for
+``HOLD`` and the MPC rides,
 
 .. math:: \\dot\\kappa = \\frac{v_{cmd} - v}{T\\,|\\sin\\hat\\alpha|}, \\qquad
           \\delta = \\kappa\\,|\\sin\\hat\\alpha|, \\qquad |\\delta| \\le \\delta_{max},
@@ -35,17 +35,21 @@ from numpy.typing import NDArray
 
 from ridempc.mpc.manoeuvre import MOVING, RETARGET_BAND, StateLayout
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.slope import TIME_CONSTANT as SLOPE_TIME
 
 if TYPE_CHECKING:  # the build's inputs carry the shoes' observer, which holds a trim
     from ridempc.mpc.stages.build import BuildInputs
 
-__all__ = ["GATE", "LIMIT", "TIME_CONSTANT", "SlopeSpeedTrim", "SlopeTrim"]
+__all__ = ["BAND", "GATE", "HOLD", "LIMIT", "TIME_CONSTANT", "SlopeSpeedTrim", "SlopeTrim"]
 
 Array = NDArray[np.float64]
 
 # [rad] 3 deg: ten times what the slope estimate reads on level ground (0.1-0.3 deg before
 # the crest of `slope-down-13`), a third of the gentlest slope a scenario rides (7 deg).
 GATE: float = math.radians(3.0)
+# [s] a slope is one the estimate has read beyond the gate for its own time constant: a step's
+# edge or a bump passes under it sooner (the estimate passes 3 deg for moments on level ground)
+HOLD: float = SLOPE_TIME
 # [s] twice the rider's speed response (a 0.2 m/s step of the command is ridden within
 # 0.5 s: the library's 0.8 s per m/s plus its lean), so the trim does not ring with it;
 # short against the 6 s a ride spends on a 3 m slope.
@@ -79,10 +83,11 @@ class SlopeSpeedTrim:
         self.gate, self.time_constant, self.limit = gate, time_constant, limit
         self.value = 0.0  # [m/s] the trim
         self.per_slope = 0.0  # [m/s] the trim per unit of the slope's sine
+        self._sloped = 0.0  # [s] how long the estimate has been beyond the gate
         self._time: float | None = None
 
     def reset(self) -> None:
-        self.value = self.per_slope = 0.0
+        self.value = self.per_slope = self._sloped = 0.0
         self._time = None
 
     def update(
@@ -106,7 +111,8 @@ class SlopeSpeedTrim:
         dt = 0.0 if self._time is None else max(0.0, time - self._time)
         self._time = time
         slope = abs(math.sin(sum(slopes) / len(slopes))) if slopes else 0.0
-        if slope <= math.sin(self.gate) or wanted < MOVING:
+        self._sloped = self._sloped + dt if slope > math.sin(self.gate) else 0.0
+        if self._sloped < HOLD or wanted < MOVING:
             self.value = 0.0  # level ground (or rest): the library's ride
             return self.value
         error = wanted - speed
