@@ -229,6 +229,7 @@ class Stages(_Frozen):
     shoe_observer: Used | None = None
     shoe_heading: Used | None = None
     guidance: Used | None = None
+    slope_trim: Used | None = None
     lean: Used | None = None
     roll_steering: Used | None = None
     roll_observer: RollObserverStage | None = None
@@ -256,6 +257,7 @@ STAGE_NEEDS: dict[str, tuple[frozenset[str], tuple[str, ...]]] = {
     "shoe_observer": (frozenset({"shoes"}), ()),
     "shoe_heading": (frozenset({"shoes"}), ("shoe_observer",)),
     "guidance": (frozenset({"shoes"}), ("shoe_observer",)),
+    "slope_trim": (frozenset({"shoes"}), ("shoe_observer",)),
     "lean": (frozenset({"knee_bar"}), ()),
     "roll_steering": (frozenset({"deck_roll"}), ()),
     "roll_observer": (frozenset({"deck_roll"}), ()),

@@ -280,6 +280,9 @@ class MpcRider(RiderReports):
             self.payload_models.absorb(tick)
         pushing = Contact.GROUND in self.book.contacts  # a foot on the ground goes straight
         steering = balancing or (self.manoeuvre.kind == REPUSH and not pushing)
+        if self.shoes is not None and self._slope_trim:  # a slope's lost speed: mpc/slope_trim.py
+            riding, slopes = not self.handover.on_backup, self.shoes.slopes.angles
+            self.shoes.trim.update(now, command.velocity, rider_speed, slopes, riding)
         roll, turn, x0 = self.commanded(tick, command, mapped, t_ref, coasting, steering)
         started = time.perf_counter()
         turned = math.remainder(self.map.frame.yaw - self.book.frame.yaw, 2.0 * math.pi)

@@ -33,6 +33,7 @@ from ridempc.mpc.push_side import PushSide
 from ridempc.mpc.readiness import start_readiness
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.rider_wbc import rider_wbc, tracking_gains
+from ridempc.mpc.slope_trim import SlopeTrim
 from ridempc.mpc.solver_process import SolverProcess
 from ridempc.mpc.stages.base import DriftSource, ProblemShaper, TickObserver, present
 from ridempc.mpc.stages.board_shapers import CrouchShaper, HeldForces, LeanShaper
@@ -184,6 +185,7 @@ class RiderParts(Controller):
         # where each foot stands along its shoe and each shoe's drag, its heading (Hovershoes)
         shoes = shoe_stages(stages, loaded, self.wbc.model, self.platform_feet, columns)
         self.shoes, self.shoe_heading, self._shoe_lines, self._shoe_columns = shoes
+        self._slope_trim = self.shoes is not None and stages.slope_trim is not None
         n_feet = len(robot.params.foot_bodies)  # the deck's roll steering and balance
         deck = deck_stages(self.pair, loaded, columns, self.mpc, n_feet, self.map.com)
         self.commands = CommandHorizon(  # the commands read over the horizon
@@ -329,7 +331,7 @@ class RiderParts(Controller):
     def _problem_shapers(self) -> tuple[ProblemShaper, ...]:
         """The problem shapers, in the order they act: the manoeuvre's (coasting, the
         commanded roll, a re-push's blend, the turn), then the board's (the crouch, the
-        lean, the shoes' lines and drags, the swing's held forces)."""
+        lean, the shoes' lines and drags, the slope's speed trim, the swing's held forces)."""
         mpc, layout, step = self.mpc, self.layout, self.pair.swing_force_step
         blend = RepushBlend(mpc, layout)
         return present(
@@ -340,5 +342,6 @@ class RiderParts(Controller):
             CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
             LeanShaper(mpc, layout) if self.lean is not None else None,
             self._shoe_lines,
+            SlopeTrim(layout, self._shoe_columns) if self._slope_trim else None,
             HeldForces(mpc, step) if step is not None else None,
         )

@@ -78,6 +78,7 @@ from numpy.typing import NDArray
 
 from ridempc.estimation.state import BoardEstimate, EstimatedState
 from ridempc.mpc.slope import SlopeEstimator
+from ridempc.mpc.slope_trim import SlopeSpeedTrim
 from ridempc.mpc.state_map import forward_speed
 from ridempc.trajopt.platforms import HovershoesBoard
 
@@ -149,6 +150,7 @@ class ShoeObserver:
         self.offsets = np.zeros(n)  # [m] d per platform
         self.drag = np.zeros(n)  # [N] D per platform
         self.slopes = SlopeEstimator(n)  # the ground's slope under each shoe
+        self.trim = SlopeSpeedTrim()  # the reference's speed trim on a slope (mpc/slope_trim.py)
 
     def update(
         self,
@@ -218,6 +220,7 @@ class ShoeObserver:
         do to this one's (an MPC problem built beside the control loop reads them)."""
         out = copy.copy(self)
         out.offsets, out.drag = self.offsets.copy(), self.drag.copy()
+        out.trim = copy.copy(self.trim)
         return out
 
     def speed_drift(self, c: Array, dt: float, speeds: Sequence[int]) -> Array:
