@@ -1,0 +1,134 @@
+"""The held speed's outer loop over the re-pushes (``mpc/push_speed.py``) and a re-push's
+reference anchored at its first push (``mpc/push_gain.py``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ridempc.mpc.manoeuvre import REPUSH, REPUSH_BAND, Manoeuvre, ManoeuvreSelector
+from ridempc.mpc.push_gain import PushAnchor, ground_time
+from ridempc.mpc.push_speed import (
+    GAIN_LIMIT,
+    INTEGRAL_TIME,
+    ROLLING_DECELERATION,
+    STROKE_PERIOD,
+    StrokeSpeedLoop,
+)
+from ridempc.mpc.reference import select_reference
+from ridempc.scenarios.scenario import Command
+from ridempc.trajopt.schedule import Contact
+
+TICK = 0.03  # [s] the MPC's period
+
+
+def _ride(loop: StrokeSpeedLoop, speeds, wanted: float, start: float = 0.0) -> float:
+    now = start
+    for speed in speeds:
+        loop.observe(now, float(speed), wanted)
+        now += TICK
+    return now
+
+
+def test_the_loop_acts_only_on_a_whole_stroke_averaged() -> None:
+    """Until a stroke's period has been seen there is no error; then the error is the
+    command against the window's mean, so a stroke's swing about it does not move it."""
+    loop = StrokeSpeedLoop()
+    _ride(loop, [0.5] * int(STROKE_PERIOD / TICK - 2), 0.7)
+    assert loop.mean is None and loop.gain == 0.0 and loop.integral == 0.0
+    loop.reset()
+    swing = 0.6 + 0.1 * np.sin(2 * np.pi * TICK * np.arange(200) / STROKE_PERIOD)
+    _ride(loop, swing, 0.7)
+    assert loop.mean == pytest.approx(0.6, abs=0.005)
+    assert loop.error == pytest.approx(0.1, abs=0.005)
+
+
+def test_a_persistent_shortfall_is_integrated_at_its_time_constant() -> None:
+    """0.05 m/s short for one integral time adds 0.05 m/s to the integral; the output is
+    the proportional part (the whole shortfall) plus it."""
+    loop = StrokeSpeedLoop()
+    end = _ride(loop, [0.65] * 45, 0.7)
+    before = loop.integral
+    _ride(loop, [0.65] * round(INTEGRAL_TIME / TICK), 0.7, end)
+    assert loop.integral - before == pytest.approx(0.05, rel=0.02)
+    assert loop.gain == pytest.approx(0.05 + loop.integral)
+
+
+def test_the_loop_is_bounded_by_a_strokes_rolling_loss_and_never_brakes() -> None:
+    assert GAIN_LIMIT == pytest.approx(ROLLING_DECELERATION * STROKE_PERIOD)
+    loop = StrokeSpeedLoop()
+    end = _ride(loop, [0.2] * 400, 0.7)  # far short for 12 s: saturated, not wound up
+    assert loop.integral == loop.gain == pytest.approx(GAIN_LIMIT)
+    _ride(loop, [0.9] * 80, 0.7, end)  # faster than the command: coasts, nothing asked
+    assert loop.gain == 0.0 and loop.integral >= 0.0
+    loop.reset()
+    assert loop.mean is None and loop.gain == 0.0
+
+
+def test_a_short_ride_is_pushed_again_sooner_and_asked_for_more() -> None:
+    selector = ManoeuvreSelector("cyberdog2", "skateboard")
+    selector.holds_speed = True
+    coasting, command = Manoeuvre("accelerate", 0.7, 0.5), Command(velocity=0.7)
+    board = 0.7 - REPUSH_BAND + 0.05
+    assert selector.repush(command, coasting, 9.0, board) is coasting
+    pushed = selector.repush(command, coasting, 9.0, board, gain=0.1)
+    assert (pushed.kind, pushed.target, pushed.gain) == (REPUSH, 0.7, 0.1)
+
+
+def test_ground_time_counts_only_the_feet_on_the_ground() -> None:
+    reference = select_reference("cyberdog2", "skateboard", REPUSH, 0.7)
+    pushes = [p.duration for p in reference.phases if Contact.GROUND in p.contacts]
+    times = np.array([0.0, reference.duration / 2, reference.duration, reference.duration + 1])
+    ground = ground_time(reference, times)
+    assert ground[0] == 0.0 and ground[2] == ground[3] == pytest.approx(sum(pushes))
+    assert np.all(np.diff(ground) >= 0.0)
+
+
+def _pushing_times(reference, n: int = 30, dt: float = 0.05) -> np.ndarray:
+    first = next(
+        sum(p.duration for p in reference.phases[:k])
+        for k, p in enumerate(reference.phases)
+        if Contact.GROUND in p.contacts
+    )
+    return first + dt * np.arange(n + 1)
+
+
+def test_an_anchored_repush_with_no_shortfall_is_the_plain_shift() -> None:
+    reference = select_reference("cyberdog2", "skateboard", REPUSH, 0.7)
+    times = _pushing_times(reference)
+    anchor = PushAnchor()
+    np.testing.assert_array_equal(anchor.extra(reference, times, 0.5, 0.45, 0.0), 0.0)
+    later = times + 0.3  # the board as the entry planned it from the anchor: 0.05 below
+    np.testing.assert_allclose(anchor.extra(reference, later, 0.6, 0.55, 0.0), 0.0)
+
+
+def test_a_stroke_that_fell_short_is_asked_back_over_the_ground_time_left() -> None:
+    """Anchored 0.05 m/s below the entry, the board 0.1 m/s further behind later: node 0
+    stays the board's, and the 0.1 m/s is asked back by the end of the last push (at most
+    the loop's bound), only while a foot is on the ground."""
+    reference = select_reference("cyberdog2", "skateboard", REPUSH, 0.7)
+    times = _pushing_times(reference)
+    anchor = PushAnchor()
+    anchor.extra(reference, times, 0.5, 0.45, 0.0)
+    later = times + 0.3
+    extra = anchor.extra(reference, later, 0.6, 0.45, 0.0)
+    assert extra[0] == 0.0 and np.all(np.diff(extra) >= -1e-12)
+    ground = ground_time(reference, later)
+    left = ground_time(reference, np.array([reference.duration]))[0] - ground[0]
+    np.testing.assert_allclose(extra, 0.1 * (ground - ground[0]) / left, atol=1e-12)
+    flat = np.diff(ground) == 0.0  # no foot on the ground: nothing more asked
+    np.testing.assert_allclose(np.diff(extra)[flat], 0.0, atol=1e-12)
+    far = anchor.extra(reference, later, 0.6, 0.0, 0.0)
+    assert far.max() <= GAIN_LIMIT + 1e-12
+
+
+def test_the_loops_gain_is_laid_over_the_entrys_ground_time() -> None:
+    """From the anchor, ``u`` is added as the feet on the ground add momentum: all of it
+    by the end of the last push."""
+    reference = select_reference("cyberdog2", "skateboard", REPUSH, 0.7)
+    start = _pushing_times(reference)[0]
+    times = start + 0.05 * np.arange(int((reference.duration - start) / 0.05) + 1)
+    extra = PushAnchor().extra(reference, times, 0.5, 0.5, 0.1)
+    assert extra[0] == 0.0 and extra[-1] == pytest.approx(0.1)
+    ground = ground_time(reference, times)
+    np.testing.assert_allclose(extra, 0.1 * (ground - ground[0]) / (ground[-1] - ground[0]))
