@@ -20,49 +20,54 @@ from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
 TICK = 0.03  # [s] the MPC's period
+CYCLE_MEAN = 0.7 - REPUSH_BAND / 2  # [m/s] what the re-pushes alone hold at 0.7 m/s
 
 
-def _ride(loop: StrokeSpeedLoop, speeds, wanted: float, start: float = 0.0) -> float:
+def _stride(loop: StrokeSpeedLoop, speeds, start: float = 0.0) -> float:
+    """The board's ``speeds`` over one stride from ``start`` [s], closed by a re-push at
+    0.7 m/s; the loop's gain."""
     now = start
     for speed in speeds:
-        loop.observe(now, float(speed), wanted)
+        loop.observe(now, float(speed))
         now += TICK
-    return now
+    return loop.stride(now, 0.7)
 
 
-def test_the_loop_acts_only_on_a_whole_stroke_averaged() -> None:
-    """Until a stroke's period has been seen there is no error; then the error is the
-    command against the window's mean, so a stroke's swing about it does not move it."""
+def test_a_held_speed_cycling_through_its_band_asks_nothing() -> None:
+    """Coasting from the command down to the rolling start and pushed back up, stride
+    after stride, the board averages the command less half the band: the loop stays idle."""
     loop = StrokeSpeedLoop()
-    _ride(loop, [0.5] * int(STROKE_PERIOD / TICK - 2), 0.7)
-    assert loop.mean is None and loop.gain == 0.0 and loop.integral == 0.0
-    loop.reset()
-    swing = 0.6 + 0.1 * np.sin(2 * np.pi * TICK * np.arange(200) / STROKE_PERIOD)
-    _ride(loop, swing, 0.7)
-    assert loop.mean == pytest.approx(0.6, abs=0.005)
-    assert loop.error == pytest.approx(0.1, abs=0.005)
+    cycle = 0.7 - REPUSH_BAND * (0.5 - 0.5 * np.cos(2 * np.pi * np.arange(120) / 120))
+    for k in range(5):
+        assert _stride(loop, cycle, 3.6 * k) == pytest.approx(0.0, abs=1e-3)
+    assert loop.integral == pytest.approx(0.0, abs=1e-3)
 
 
-def test_a_persistent_shortfall_is_integrated_at_its_time_constant() -> None:
-    """0.05 m/s short for one integral time adds 0.05 m/s to the integral; the output is
-    the proportional part (the whole shortfall) plus it."""
+def test_a_stride_that_falls_short_is_asked_back_with_its_integral() -> None:
+    """A stride 0.05 m/s short of the cycle's mean asks a re-push for that shortfall (the
+    proportional part) plus the shortfall integrated over the stride at the strokes'
+    period; a second one adds to the integral; with no speed seen nothing changes."""
     loop = StrokeSpeedLoop()
-    end = _ride(loop, [0.65] * 45, 0.7)
-    before = loop.integral
-    _ride(loop, [0.65] * round(INTEGRAL_TIME / TICK), 0.7, end)
-    assert loop.integral - before == pytest.approx(0.05, rel=0.02)
-    assert loop.gain == pytest.approx(0.05 + loop.integral)
+    assert loop.stride(1.0, 0.7) == 0.0 and loop.integral == 0.0  # no speed seen yet
+    steps = round(1.2 / TICK)
+    gain = _stride(loop, [CYCLE_MEAN - 0.05] * steps, 1.0)
+    integral = 0.05 * steps * TICK / INTEGRAL_TIME
+    assert loop.integral == pytest.approx(integral)
+    assert gain == pytest.approx(0.05 + integral)
+    _stride(loop, [CYCLE_MEAN - 0.05] * steps, 2.2)
+    assert loop.integral == pytest.approx(2 * integral)
 
 
 def test_the_loop_is_bounded_by_a_strokes_rolling_loss_and_never_brakes() -> None:
     assert GAIN_LIMIT == pytest.approx(ROLLING_DECELERATION * STROKE_PERIOD)
     loop = StrokeSpeedLoop()
-    end = _ride(loop, [0.2] * 400, 0.7)  # far short for 12 s: saturated, not wound up
-    assert loop.integral == loop.gain == pytest.approx(GAIN_LIMIT)
-    _ride(loop, [0.9] * 80, 0.7, end)  # faster than the command: coasts, nothing asked
-    assert loop.gain == 0.0 and loop.integral >= 0.0
+    for k in range(3):  # far short for three strides: saturated, not wound up
+        assert _stride(loop, [0.2] * 120, 3.6 * k) == pytest.approx(GAIN_LIMIT)
+    assert loop.integral == pytest.approx(GAIN_LIMIT)
+    assert _stride(loop, [0.9] * 120, 10.8) == 0.0  # faster: coasts, nothing asked
+    assert loop.integral >= 0.0
     loop.reset()
-    assert loop.mean is None and loop.gain == 0.0
+    assert loop.mean is None and loop.gain == 0.0 and loop.integral == 0.0
 
 
 def test_a_short_ride_is_pushed_again_sooner_and_asked_for_more() -> None:

@@ -69,11 +69,13 @@ class ManoeuvreChoice:
         wanted = selector.select(asked, manoeuvre, now, rider_speed)
         loop = self.speed_loop  # over the ride held after its push-off: coasts and re-pushes
         if selector.holds_speed and (coasting or manoeuvre.kind == REPUSH):
-            loop.observe(now, speed, command.velocity)
+            loop.observe(now, speed)
         else:
             loop.reset()
         if wanted is manoeuvre and coasting:  # slowed: push again
             wanted = selector.repush(command, wanted, now, speed, loop.gain)
+            if wanted is not manoeuvre:  # a stride ends: the loop's sample, its gain asked
+                wanted = replace(wanted, gain=loop.stride(now, command.velocity))
         if wanted is manoeuvre:
             return None
         mpc.retarget(wanted.library_kind, wanted.target)
