@@ -109,22 +109,36 @@ def test_an_anchored_repush_with_no_shortfall_is_the_plain_shift() -> None:
 
 def test_a_stroke_that_fell_short_is_asked_back_over_the_ground_time_left() -> None:
     """Anchored 0.05 m/s below the entry, the board 0.1 m/s further behind later: node 0
-    stays the board's, and the 0.1 m/s is asked back by the end of the last push (at most
-    the loop's bound), only while a foot is on the ground."""
+    stays the board's, and the 0.1 m/s is asked back by the end of the last push, only
+    while a foot is on the ground, and no more than the outer loop's gain."""
+    reference = select_reference("cyberdog2", "skateboard", REPUSH, 0.7)
+    times = _pushing_times(reference)
+    anchor = PushAnchor()
+    anchor.extra(reference, times, 0.5, 0.45, GAIN_LIMIT)
+    later = times + 0.3
+    ground = ground_time(reference, later)
+    whole = ground_time(reference, np.array([times[0], reference.duration]))
+    gained = GAIN_LIMIT * (ground - whole[0]) / (whole[1] - whole[0])
+    deficit = 0.6 - 0.05 + gained[0] - 0.45  # the anchored reference at node 0, the board
+    extra = anchor.extra(reference, later, 0.6, 0.45, GAIN_LIMIT)
+    assert extra[0] == 0.0 and np.all(np.diff(extra) >= -1e-12)
+    left = whole[1] - ground[0]
+    share = (ground - ground[0]) / left
+    expected = min(deficit, GAIN_LIMIT) * share + gained - gained[0]
+    np.testing.assert_allclose(extra, expected, atol=1e-12)
+    flat = np.diff(ground) == 0.0  # no foot on the ground: nothing more asked
+    np.testing.assert_allclose(np.diff(extra)[flat], 0.0, atol=1e-12)
+    far = anchor.extra(reference, later, 0.6, 0.0, 0.05)  # far behind, the loop asks 0.05
+    assert far.max() <= 2 * 0.05 + 1e-12
+
+
+def test_a_stride_the_loop_finds_held_is_not_asked_back() -> None:
+    """With no gain from the outer loop a re-push is the plain shift, however short."""
     reference = select_reference("cyberdog2", "skateboard", REPUSH, 0.7)
     times = _pushing_times(reference)
     anchor = PushAnchor()
     anchor.extra(reference, times, 0.5, 0.45, 0.0)
-    later = times + 0.3
-    extra = anchor.extra(reference, later, 0.6, 0.45, 0.0)
-    assert extra[0] == 0.0 and np.all(np.diff(extra) >= -1e-12)
-    ground = ground_time(reference, later)
-    left = ground_time(reference, np.array([reference.duration]))[0] - ground[0]
-    np.testing.assert_allclose(extra, 0.1 * (ground - ground[0]) / left, atol=1e-12)
-    flat = np.diff(ground) == 0.0  # no foot on the ground: nothing more asked
-    np.testing.assert_allclose(np.diff(extra)[flat], 0.0, atol=1e-12)
-    far = anchor.extra(reference, later, 0.6, 0.0, 0.0)
-    assert far.max() <= GAIN_LIMIT + 1e-12
+    np.testing.assert_array_equal(anchor.extra(reference, times + 0.3, 0.6, 0.3, 0.0), 0.0)
 
 
 def test_the_loops_gain_is_laid_over_the_entrys_ground_time() -> None:

@@ -30,14 +30,17 @@ the entry's gain from the board it met plus the outer loop's :math:`u`
 the entry's ground time from :math:`t_a` to :math:`t`, :math:`G` all of it. Node 0 is still
 the board (a reference ahead of the board at node 0 had the deck feet drive the deck
 against the body: a board at 0.31 m/s braked to 0.15 in 0.2 s while the body ran ahead);
-the board's deficit behind :math:`r` there, :math:`D = r(t_0) - v`, at most
-:math:`u_{max}`, is asked back over the ground time left, :math:`f_k = (g(t_k) - g(t_0)) /
-(G - g(t_0))`, so every node's speed changes by
+the board's deficit behind :math:`r` there, :math:`D = r(t_0) - v`, is asked back over the
+ground time left, :math:`f_k = (g(t_k) - g(t_0)) / (G - g(t_0))`, but no more than
+:math:`u`: the outer loop sets how much more than its entry a re-push is asked, and a
+stride that holds its speed is asked nothing (a stroke's shortfall asked back in full on a
+board that held 0.5-0.7 m/s drove the next stroke to 0.83 m/s and into a fall,
+``docs/tuning.md``). Every node's speed changes by
 
-.. math:: \\delta_k = v - v^{ref}(t_0) + \\mathrm{clip}(D, 0, u_{max})\\, f_k
+.. math:: \\delta_k = v - v^{ref}(t_0) + \\mathrm{clip}(D, 0, u)\\, f_k
     + u\\, (g(t_k) - g(t_0)) / G,
 
-which with no deficit and no :math:`u` is the plain shift above.
+which with no :math:`u` is the plain shift above.
 """
 
 from __future__ import annotations
@@ -49,7 +52,6 @@ from numpy.typing import NDArray
 
 from ridempc.mpc.manoeuvre import StateLayout
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.push_speed import GAIN_LIMIT
 from ridempc.mpc.reference import MotionReference
 from ridempc.trajopt.schedule import Contact
 
@@ -72,14 +74,9 @@ def ground_time(reference: MotionReference, times: Array) -> Array:
 
 
 class PushAnchor:
-    """A re-push's speeds anchored at its first push (see the module docstring).
+    """A re-push's speeds anchored at its first push (see the module docstring)."""
 
-    Args:
-        limit: The most of the board's deficit asked back, :math:`u_{max}` [m/s].
-    """
-
-    def __init__(self, limit: float = GAIN_LIMIT) -> None:
-        self.limit = limit
+    def __init__(self) -> None:
         self._anchor: tuple[float, float] | None = None  # (t_a, Delta) [s], [m/s]
 
     def reset(self) -> None:
@@ -107,7 +104,7 @@ class PushAnchor:
         deficit = entry_speed + offset + gained[0] - speed
         left = whole - nodes[0]
         share = (nodes - nodes[0]) / left if left > 0.0 else np.zeros_like(nodes)
-        return min(max(deficit, 0.0), self.limit) * share + gained - gained[0]
+        return min(max(deficit, 0.0), gain) * share + gained - gained[0]
 
 
 def shifted_speeds(

@@ -53,8 +53,8 @@ PROPORTIONAL: float = 1.0
 # [s] a persistent shortfall is asked back once more per stroke period: the integral time
 # is the strokes' period, the fastest the strokes can give speed back
 INTEGRAL_TIME: float = STROKE_PERIOD
-# [m/s] the most a re-push is asked beyond its entry: what rolling resistance takes over one
-# stroke's period (one stroke's loss replaced twice in a stride of two), 0.17 m/s
+# [m/s] the most the loop asks a re-push to add beyond its entry's gain: what rolling
+# resistance takes over one stroke's period, 0.17 m/s (one more stroke's worth of loss)
 GAIN_LIMIT: float = ROLLING_DECELERATION * STROKE_PERIOD
 
 
