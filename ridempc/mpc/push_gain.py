@@ -17,30 +17,6 @@ forward speed (the centre of mass's along the board's heading and each platform'
 :math:`p_k \\mathrel{+}= \\Delta v \\sum_{j<k} (\\cos\\psi_j, \\sin\\psi_j)\\, \\Delta t`
 (:math:`\\psi` the first platform's heading): the push gains over the horizon what the
 entry gains there, from wherever the board is.
-
-Shifted so at every tick alone, a stroke that falls short is never asked back: the next
-starts from the slower board. So the reference is *anchored* at the re-push's first push
-(:class:`PushAnchor`): there the board's offset from the entry, :math:`\\Delta = v(t_a) -
-v^{ref}(t_a)`, is taken once, and the re-push is to ride
-
-.. math:: r(t) = v^{ref}(t) + \\Delta + u\\, g(t) / G,
-
-the entry's gain from the board it met plus the outer loop's :math:`u`
-(:mod:`~ridempc.mpc.push_speed`), added as the pushing foot adds momentum: :math:`g(t)` is
-the entry's ground time from :math:`t_a` to :math:`t`, :math:`G` all of it. Node 0 is still
-the board (a reference ahead of the board at node 0 had the deck feet drive the deck
-against the body: a board at 0.31 m/s braked to 0.15 in 0.2 s while the body ran ahead);
-the board's deficit behind :math:`r` there, :math:`D = r(t_0) - v`, is asked back over the
-ground time left, :math:`f_k = (g(t_k) - g(t_0)) / (G - g(t_0))`, but no more than
-:math:`u`: the outer loop sets how much more than its entry a re-push is asked, and a
-stride that holds its speed is asked nothing (a stroke's shortfall asked back in full on a
-board that held 0.5-0.7 m/s drove the next stroke to 0.83 m/s and into a fall,
-``docs/tuning.md``). Every node's speed changes by
-
-.. math:: \\delta_k = v - v^{ref}(t_0) + \\mathrm{clip}(D, 0, u)\\, f_k
-    + u\\, (g(t_k) - g(t_0)) / G,
-
-which with no :math:`u` is the plain shift above.
 """
 
 from __future__ import annotations
@@ -48,70 +24,16 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ridempc.mpc.manoeuvre import StateLayout
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.reference import MotionReference
-from ridempc.trajopt.schedule import Contact
 
-__all__ = ["PushAnchor", "ground_time", "shifted_speeds"]
-
-Array = NDArray[np.float64]
+__all__ = ["shifted_speeds"]
 
 
-def ground_time(reference: MotionReference, times: Array) -> Array:
-    """The entry's time with a foot on the ground from its start to each of ``times`` [s]
-    (reference time): the time in which the pushing foot adds momentum."""
-    times = np.asarray(times, dtype=float)
-    total, start = np.zeros_like(times), 0.0
-    for phase in reference.phases:
-        end = start + phase.duration
-        if Contact.GROUND in phase.contacts:
-            total += np.clip(times, start, end) - start
-        start = end
-    return total
-
-
-class PushAnchor:
-    """A re-push's speeds anchored at its first push (see the module docstring)."""
-
-    def __init__(self) -> None:
-        self._anchor: tuple[float, float] | None = None  # (t_a, Delta) [s], [m/s]
-
-    def reset(self) -> None:
-        """Forget the anchor (a manoeuvre began)."""
-        self._anchor = None
-
-    def extra(
-        self,
-        reference: MotionReference,
-        times: Array,
-        entry_speed: float,
-        speed: float,
-        gain: float,
-    ) -> Array:
-        """:math:`\\delta_k - (v - v^{ref}(t_0))` [m/s], what the anchor adds to the plain
-        shift at the nodes' reference ``times`` [s], with ``entry_speed`` the entry's board
-        speed at node 0 [m/s], ``speed`` the board's [m/s] and ``gain`` the loop's
-        :math:`u` [m/s]; anchored at the first call since :meth:`reset`."""
-        if self._anchor is None:
-            self._anchor = (float(times[0]), speed - entry_speed)
-        start, offset = self._anchor
-        ground = ground_time(reference, np.concatenate([[start], times, [reference.duration]]))
-        nodes, whole = ground[1:-1] - ground[0], ground[-1] - ground[0]
-        gained = gain * nodes / whole if whole > 0.0 else np.zeros_like(nodes)
-        deficit = entry_speed + offset + gained[0] - speed
-        left = whole - nodes[0]
-        share = (nodes - nodes[0]) / left if left > 0.0 else np.zeros_like(nodes)
-        return min(max(deficit, 0.0), gain) * share + gained - gained[0]
-
-
-def shifted_speeds(
-    problem: MpcProblem, layout: StateLayout, speed: float, extra: Array | None = None
-) -> MpcProblem:
+def shifted_speeds(problem: MpcProblem, layout: StateLayout, speed: float) -> MpcProblem:
     """``problem`` with its reference's speeds shifted to start at the board's ``speed``
-    [m/s] (see the module docstring), each node's by ``extra`` [m/s] (nodes,) more."""
+    [m/s] (see the module docstring)."""
     names = layout.names
     platform = layout.prefixes[0]
     states = problem.state_reference.copy()
@@ -119,15 +41,12 @@ def shifted_speeds(
     heading = layout.heading(platform)
     if board_speed is None or heading is None:
         return problem
-    change = float(speed) - float(states[0, board_speed]) + np.zeros(len(states))
-    if extra is not None:
-        change += extra
+    change = float(speed) - float(states[0, board_speed])
     direction = np.column_stack([np.cos(states[:, heading]), np.sin(states[:, heading])])
-    steps = change[:-1, None] * direction[:-1] * problem.dt
-    travelled = np.vstack([np.zeros(2), np.cumsum(steps, axis=0)])
+    travelled = np.vstack([np.zeros(2), np.cumsum(direction[:-1] * problem.dt, axis=0)])
     for prefix in ("com_", *layout.prefixes):
-        states[:, [names[f"{prefix}x"], names[f"{prefix}y"]]] += travelled
-    states[:, [names["vx"], names["vy"]]] += change[:, None] * direction
+        states[:, [names[f"{prefix}x"], names[f"{prefix}y"]]] += change * travelled
+    states[:, [names["vx"], names["vy"]]] += change * direction
     for prefix in layout.prefixes:
         index = layout.speed(prefix)
         if index is not None:

@@ -641,7 +641,7 @@ class MpcRider(Controller):
             switched,
             copy.copy(self.lean),
             self.shoes.frozen() if self.shoes is not None else None,
-            (self.manoeuvre.kind, self.manoeuvre.target, self.manoeuvre.gain),
+            (self.manoeuvre.kind, self.manoeuvre.target),
             self._plan.first_input if self._plan is not None else None,
             self._contacts,
             None if self.mpc.reference is self._sent_reference else self.mpc.reference,
