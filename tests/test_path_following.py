@@ -102,13 +102,16 @@ def test_path_metrics_from_a_log() -> None:
 
 
 def test_the_steering_scenarios_load() -> None:
-    for name in ("yaw-steps", "yaw-steps-hold", "circle", "slalom", "circle-hold"):
+    for name in ("yaw-steps", "yaw-steps-hold", "circle", "slalom", "circle-hold", "slalom-hold"):
         scenario = resolve_scenario(name, "skateboard")
         assert scenario.boards == ("skateboard",)
     held = resolve_scenario("yaw-steps-hold", "skateboard").push_off
     assert held is not None and held.hold  # pushed again while rolling
     circle = resolve_scenario("circle-hold", "skateboard")
     assert circle.push_off is not None and circle.push_off.hold and circle.path is not None
+    slalom = resolve_scenario("slalom-hold", "skateboard")
+    assert slalom.push_off is not None and slalom.push_off.hold
+    assert slalom.path.spacing == 3.0 and slalom.path.gates == 6  # type: ignore[union-attr]
     assert not resolve_scenario("push-off-0.5", "skateboard").push_off.hold  # type: ignore[union-attr]
     assert resolve_scenario("circle", "skateboard").path.radius == 3.0  # type: ignore[union-attr]
 

@@ -106,11 +106,14 @@ class Manoeuvre:
         kind: ``hold``, ``accelerate``, ``repush`` or ``stop``.
         target: The entry's target speed [m/s].
         start: Simulation time at which the reference's time is zero [s].
+        gain: For a ``repush``, the speed it is asked to add beyond its entry's [m/s]
+            (:mod:`~ridempc.mpc.push_speed`).
     """
 
     kind: str
     target: float
     start: float = 0.0
+    gain: float = 0.0
 
     @property
     def library_kind(self) -> str:
@@ -264,27 +267,30 @@ class ManoeuvreSelector:
                 return current
         return goal
 
-    def repush(self, command: Command, current: Manoeuvre, now: float, speed: float) -> Manoeuvre:
+    def repush(
+        self, command: Command, current: Manoeuvre, now: float, speed: float, gain: float = 0.0
+    ) -> Manoeuvre:
         """A stride pushed again from the rolling board, or ``current``: on a board the
         rider drives only by pushing (no ``stop`` entries), once the board has slowed
-        :data:`REPUSH_BAND` below a commanded speed that is not rest, the library's
-        ``repush`` entry of that speed (clamped to its range), which starts from a board
-        rolling :data:`REPUSH_BAND` slower. Only where the ride holds its speed
-        (:attr:`holds_speed`, a scenario's ``push_off.hold``); the caller asks only while the
-        rider coasts.
+        :data:`REPUSH_BAND` less ``gain`` below a commanded speed that is not rest, the
+        library's ``repush`` entry of that speed (clamped to its range), which starts from a
+        board rolling :data:`REPUSH_BAND` slower, asked for ``gain`` more. Only where the
+        ride holds its speed (:attr:`holds_speed`, a scenario's ``push_off.hold``); the
+        caller asks only while the rider coasts.
 
         Args:
             command: The command of the moment.
             current: The manoeuvre under way (coasting at its end).
             now: Time [s].
             speed: The board's speed [m/s].
+            gain: The held speed's outer loop's :math:`u` [m/s] (:mod:`~ridempc.mpc.push_speed`).
         """
         wanted = command.velocity
         if not self.holds_speed or REPUSH not in self.targets:
             return current
-        if wanted < MOVING or speed > wanted - REPUSH_BAND:
+        if wanted < MOVING or speed > wanted - REPUSH_BAND + gain:
             return current
-        return Manoeuvre(REPUSH, self._clamped(REPUSH, wanted), now)
+        return Manoeuvre(REPUSH, self._clamped(REPUSH, wanted), now, gain)
 
     @staticmethod
     def phase_start(

@@ -308,7 +308,7 @@ class MpcRider(RiderReports):
             switched,
             copy.copy(self.lean),
             self.shoes.frozen() if self.shoes is not None else None,
-            (self.manoeuvre.kind, self.manoeuvre.target),
+            (self.manoeuvre.kind, self.manoeuvre.target, self.manoeuvre.gain),
             self.book.plan.first_input if self.book.plan is not None else None,
             self.book.contacts,
             None if self.mpc.reference is self._sent_reference else self.mpc.reference,

@@ -51,9 +51,9 @@ class LeanShaper:
 
     def __init__(self, mpc: LinearMpc, layout: StateLayout) -> None:
         self._mpc, self._layout = mpc, layout
-        self._shift: tuple[tuple[str, float], StaticShift] | None = None
+        self._shift: tuple[tuple[str, float, float], StaticShift] | None = None
 
-    def _balance(self, t_ref: float, manoeuvre: tuple[str, float]) -> StaticShift:
+    def _balance(self, t_ref: float, manoeuvre: tuple[str, float, float]) -> StaticShift:
         """How the reference's forces move per metre of the lean's offset."""
         if self._shift is None or self._shift[0] != manoeuvre:
             names, rider = self._layout.names, self._layout.rider_states

@@ -43,7 +43,7 @@ class BuildInputs(NamedTuple):
     [s], the board's speed [m/s], the commanded roll at the horizon's nodes [rad], the
     turn over its steps [rad/s], the turn so far [rad], whether the rider coasts, whether
     the manoeuvre switched at this tick, the lean loop (a copy, or None), the shoes'
-    observer (frozen, or None), the manoeuvre's kind and target, the plan in force's
+    observer (frozen, or None), the manoeuvre's kind, target and gain, the plan in force's
     first input (or None), the contacts of the last MPC step, the reference tracked
     when it changed at this tick (else None), whether any manoeuvre began at this tick,
     and the commanded lateral offset of the feet [m] (:mod:`~ridempc.mpc.foot_spread`);
@@ -62,7 +62,7 @@ class BuildInputs(NamedTuple):
     switched: bool
     lean: LeanSteering | None
     shoes: ShoeObserver | None
-    manoeuvre: tuple[str, float]
+    manoeuvre: tuple[str, float, float]
     first_input: Array | None
     contacts: tuple[Contact, ...]
     reference: MotionReference | None

@@ -5,7 +5,8 @@ command (its speed read ahead where the pair previews it,
 :meth:`~ridempc.mpc.stages.commands.CommandHorizon.speed_command`): a push-off or a speed
 change follows its library trajectory, then rides on; on a board only a push drives, once
 the coast has slowed below the command, it pushes again from the rolling board (the
-library's ``repush``), from the side its turn needs (:mod:`~ridempc.mpc.push_side`). The
+library's ``repush``), from the side its turn needs (:mod:`~ridempc.mpc.push_side`), when
+and with the gain the held speed's outer loop asks (:mod:`~ridempc.mpc.push_speed`). The
 manoeuvre is chosen, and its phase matched, on the centre of mass's speed, which the
 reference's ``vx`` is: read off the feet, a Segway's speed swung +-0.3 m/s about the
 rider's at 3-4 m/s and started a 4 m/s push 0.36 m/s ahead of the rider.
@@ -19,6 +20,7 @@ from ridempc.mpc.controller import LinearMpc
 from ridempc.mpc.manoeuvre import REPUSH, Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import MpcPair
 from ridempc.mpc.push_side import PushSide, first_stride
+from ridempc.mpc.push_speed import StrokeSpeedLoop
 from ridempc.mpc.stages.commands import CommandHorizon
 from ridempc.scenarios.scenario import Command
 
@@ -48,6 +50,7 @@ class ManoeuvreChoice:
     ) -> None:
         self._selector, self._mpc, self._layout = selector, mpc, layout
         self._pair, self._push_side, self._commands = pair, push_side, commands
+        self.speed_loop = StrokeSpeedLoop()
 
     def __call__(
         self,
@@ -64,8 +67,15 @@ class ManoeuvreChoice:
         selector, mpc = self._selector, self._mpc
         asked = self._commands.speed_command(command, now)
         wanted = selector.select(asked, manoeuvre, now, rider_speed)
-        if wanted is manoeuvre and coasting:
-            wanted = selector.repush(command, wanted, now, speed)  # slowed: push again
+        loop = self.speed_loop  # over the ride held after its push-off: coasts and re-pushes
+        if selector.holds_speed and (coasting or manoeuvre.kind == REPUSH):
+            loop.observe(now, speed)
+        else:
+            loop.reset()
+        if wanted is manoeuvre and coasting:  # slowed: push again
+            wanted = selector.repush(command, wanted, now, speed, loop.gain)
+            if wanted is not manoeuvre:  # a stride ends: the loop's sample, its gain asked
+                wanted = replace(wanted, gain=loop.stride(now, command.velocity))
         if wanted is manoeuvre:
             return None
         mpc.retarget(wanted.library_kind, wanted.target)
