@@ -57,62 +57,20 @@ def test_the_riding_keyframe_crouches_cassie_by_a_quarter_metre(cassie) -> None:
     np.testing.assert_array_equal(ride_qpos(cassie, "hovershoes"), cassie.stance_qpos("hovershoes"))
 
 
-def _at_height(problem, row: int, height: float):
-    """``problem`` planned from a rider whose centre of mass is at ``height`` [m]."""
-    start = problem.initial_state.copy()
-    start[row] = height
-    return replace(problem, initial_state=start)
-
-
 def test_the_crouch_comes_in_over_its_ramp(segway_rider, problem) -> None:
-    """A rider on her reference (the MPC's ride from the start) is lowered by the ramp's
-    share of the drop at every node."""
     crouch = Crouch(-0.2)
     height = segway_rider.layout.names["com_z"]
     start = 10.0
     before = problem.state_reference
     assert crouch.lower(problem, height, start) is problem  # the ride's first tick: not yet
-    z0 = before[0, height]
-    half = crouch.lower(
-        _at_height(problem, height, z0 - 0.1), height, start + CROUCH_DELAY + 0.5 * CROUCH_SECONDS
-    )
+    half = crouch.lower(problem, height, start + CROUCH_DELAY + 0.5 * CROUCH_SECONDS)
     np.testing.assert_allclose(half.state_reference[:, height], before[:, height] - 0.1)
-    full = crouch.lower(
-        _at_height(problem, height, z0 - 0.2), height, start + CROUCH_DELAY + 2.0 * CROUCH_SECONDS
-    )
+    full = crouch.lower(problem, height, start + CROUCH_DELAY + 2.0 * CROUCH_SECONDS)
     np.testing.assert_allclose(full.state_reference[:, height], before[:, height] - 0.2)
     others = np.arange(before.shape[1]) != height
     np.testing.assert_array_equal(full.state_reference[:, others], before[:, others])
     with pytest.raises(ValueError, match="height"):
         Crouch(float("nan"))
-
-
-def test_a_rider_above_her_crouch_is_lowered_at_the_crouchs_own_speed(
-    segway_rider, problem
-) -> None:
-    """A rider taken over mid-crouch, 0.1 m above a fully lowered reference: the reference
-    starts at her height and descends at the crouch's speed, drop / CROUCH_SECONDS, with
-    that descent on the vertical velocity's row; a rider below her reference (sinking
-    under a payload) sees the reference as before."""
-    crouch = Crouch(-0.2)
-    names = segway_rider.layout.names
-    height, vz = names["com_z"], names["vz"]
-    now = 10.0
-    crouch.lower(problem, height, now)
-    done = now + CROUCH_DELAY + CROUCH_SECONDS
-    before = problem.state_reference
-    lowered = before[:, height] - 0.2
-    speed = 0.2 / CROUCH_SECONDS  # [m/s]
-    above = crouch.lower(_at_height(problem, height, lowered[0] + 0.1), height, done, vz)
-    times = problem.dt * np.arange(len(lowered))
-    expected = np.maximum(lowered, lowered[0] + 0.1 - speed * times)
-    np.testing.assert_allclose(above.state_reference[:, height], expected)
-    assert np.all(expected > lowered)  # 0.1 m takes longer than the horizon at that speed
-    slope = above.state_reference[:-1, vz] - before[:-1, vz]
-    np.testing.assert_allclose(slope, -speed - np.diff(lowered) / problem.dt, atol=1e-9)
-    below = crouch.lower(_at_height(problem, height, lowered[0] - 0.05), height, done, vz)
-    np.testing.assert_allclose(below.state_reference[:, height], lowered)
-    np.testing.assert_array_equal(below.state_reference[:, vz], before[:, vz])
 
 
 def test_standing_the_lean_grows_against_the_turn_and_moves_the_balance_along(

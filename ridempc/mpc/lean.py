@@ -152,38 +152,17 @@ class Crouch:
         )
         return cls(drop)
 
-    def lower(
-        self, problem: MpcProblem, index: int, now: float, rate: int | None = None
-    ) -> MpcProblem:
+    def lower(self, problem: MpcProblem, index: int, now: float) -> MpcProblem:
         """``problem`` with its reference's state ``index`` (the CoM height) lowered by the
-        share of the drop brought in at ``now`` [s], approached from the rider's height
-        :math:`z_0` no faster than the crouch is brought in (:meth:`reached`), and, with
-        ``rate`` (the vertical velocity's state), that approach's slope added to its row."""
+        share of the drop brought in at ``now`` [s]."""
         if self._start is None:
             self._start = now
         share = min(max((now - self._start - CROUCH_DELAY) / CROUCH_SECONDS, 0.0), 1.0)
         if share == 0.0:
             return problem
         states = problem.state_reference.copy()
-        heights = self.reached(
-            states[:, index] + self.drop * share, problem.initial_state[index], problem.dt
-        )
-        if rate is not None:
-            states[:-1, rate] += np.diff(heights - states[:, index]) / problem.dt
-        states[:, index] = heights
+        states[:, index] += self.drop * share
         return replace(problem, state_reference=states)
-
-    def reached(self, heights: Array, start: float, dt: float) -> Array:
-        """The reference's heights ``heights`` [m] at the horizon's nodes (``dt`` [s]
-        apart) no further below the rider's height ``start`` [m] than the crouch's own
-        speed reaches, :math:`z_k \\ge z_0 - k\\,\\Delta t\\, |\\Delta z| / T_c`
-        (``CROUCH_SECONDS`` :math:`T_c`): a rider that starts on the backup balance (the
-        pair's ``takeover``) crouches at its own pace, and the MPC taking over mid-crouch
-        would otherwise plan to drop her onto a reference already lowered further (4-8 cm
-        at a 0.9 s takeover, which tripped the handover's deviation 0.1 s later). A rider
-        below her reference (sinking under a payload) is not hidden from it."""
-        reach = abs(self.drop) / CROUCH_SECONDS * dt * np.arange(len(heights))
-        return np.maximum(heights, start - reach)
 
 
 class LeanSteering:

@@ -435,11 +435,7 @@ class MpcRider(Controller):
             RollCommand(mpc, layout),
             blend,
             Turn(layout),
-            (
-                CrouchShaper(self.crouch, layout.names["com_z"], layout.names.get("vz"))
-                if self.crouch is not None
-                else None
-            ),
+            CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
             LeanShaper(mpc, layout) if self.lean is not None else None,
             self._shoe_lines,
             HeldForces(mpc, step) if step is not None else None,

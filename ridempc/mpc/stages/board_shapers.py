@@ -34,14 +34,13 @@ __all__ = ["CrouchShaper", "HeldForces", "LeanShaper", "ShoeLines"]
 
 
 class CrouchShaper:
-    """The reference's centre of mass lowered into the riding crouch (row ``com_z``, its
-    approach's slope on row ``vz``, or None)."""
+    """The reference's centre of mass lowered into the riding crouch (row ``com_z``)."""
 
-    def __init__(self, crouch: Crouch, com_z: int, vz: int | None = None) -> None:
-        self.crouch, self._com_z, self._vz = crouch, com_z, vz
+    def __init__(self, crouch: Crouch, com_z: int) -> None:
+        self.crouch, self._com_z = crouch, com_z
 
     def __call__(self, problem: MpcProblem, inputs: BuildInputs) -> MpcProblem:
-        return self.crouch.lower(problem, self._com_z, inputs.now, self._vz)
+        return self.crouch.lower(problem, self._com_z, inputs.now)
 
 
 class LeanShaper:
