@@ -140,7 +140,7 @@ from ridempc.mpc.stages.support import contacts_to_feet, foot_support
 from ridempc.mpc.stages.triggers import DropWatch, HandoverCheck, PushWatch, handover_triggers
 from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.mpc.stagger import standby_phase
-from ridempc.mpc.state_map import PlanarFrame, StateMap, forward_speed
+from ridempc.mpc.state_map import GROUND_FILTER_S, PlanarFrame, StateMap, forward_speed
 from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -293,8 +293,13 @@ class MpcRider(Controller):
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_pair(reference.state_names, self.pair)
+        ground = self.pair.description.mpc.ground_rate_filter  # its rise rate's lag [s]
         self.map = StateMap(
-            self.pinocchio, reference.state_names, self.pair.board_states, base=self.pair.base
+            self.pinocchio,
+            reference.state_names,
+            self.pair.board_states,
+            base=self.pair.base,
+            ground_rate_filter=GROUND_FILTER_S if ground is None else ground,
         )
         self.wbc = rider_wbc(robot, board, loaded, self.pinocchio, self.pair, wbc_solver)
         self._feedforward = tuning.feedforward
