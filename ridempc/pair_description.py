@@ -127,6 +127,11 @@ class MpcSection(_Frozen):
     unrealised_inputs: tuple[str, ...] = Field(
         default=(), description="Board inputs the rider does not realise, held at zero."
     )
+    ground_rate_filter: Positive | None = Field(
+        default=None,
+        le=10.0,
+        description="Lag of the followed ground's rise rate [s] (mpc/state_map.py).",
+    )
 
     @model_validator(mode="after")
     def _known_pyramid(self) -> MpcSection:

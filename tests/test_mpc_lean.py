@@ -195,3 +195,9 @@ def test_on_the_segway_cassie_crouches_and_turns_by_the_knee_bar(cassie, tmp_pat
     assert np.abs(log["yaw_rate"][before]).max() < 0.15  # [rad/s] straight before the command
     assert log["yaw_rate"][turning].mean() > 0.35, log["yaw_rate"][turning].mean()  # [rad/s]
     assert log["firmware_knee_bar"][turning].mean() > 0.02  # [rad] the shins push the bar
+
+
+def test_the_segway_rider_follows_the_grounds_rate_slowly(segway_rider) -> None:
+    """The pair file's ``ground_rate_filter`` reaches the rider's state map (1 s: the
+    firmware's pitch swing kept out of the rider's vertical rate up a slope)."""
+    assert segway_rider.map.ground_rate_filter == 1.0

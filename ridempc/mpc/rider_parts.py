@@ -53,7 +53,7 @@ from ridempc.mpc.stages.triggers import DropWatch, PushWatch, handover_triggers
 from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.mpc.stages.wbc_targets import TargetsFromPlan
 from ridempc.mpc.stagger import standby_phase
-from ridempc.mpc.state_map import StateMap
+from ridempc.mpc.state_map import GROUND_FILTER_S, StateMap
 from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -159,8 +159,13 @@ class RiderParts(Controller):
         self.manoeuvre: Manoeuvre = first
         reference = self.mpc.reference
         self.layout = StateLayout.from_pair(reference.state_names, self.pair)
+        ground = self.pair.description.mpc.ground_rate_filter  # its rise rate's lag [s]
         self.map = StateMap(
-            self.pinocchio, reference.state_names, self.pair.board_states, base=self.pair.base
+            self.pinocchio,
+            reference.state_names,
+            self.pair.board_states,
+            base=self.pair.base,
+            ground_rate_filter=GROUND_FILTER_S if ground is None else ground,
         )
         self.wbc = rider_wbc(robot, board, loaded, self.pinocchio, self.pair, wbc_solver)
         self._feedforward = tuning.feedforward

@@ -172,6 +172,7 @@ class StateMap:
             quantity (:attr:`~ridempc.mpc.pairs.MpcPair.board_states`).
         base: The robot's base body (its description's ``base_body``): the states
             ``<base>_roll``, ``<base>_pitch``, ``<base>_yaw`` are its Z-Y-X angles.
+        ground_rate_filter: The followed ground's rate's lag [s] (:meth:`follow_ground`).
 
     Raises:
         ConfigError: A state name the map cannot fill.
@@ -184,8 +185,10 @@ class StateMap:
         board_states: Mapping[str, BoardState],
         *,
         base: str,
+        ground_rate_filter: float = GROUND_FILTER_S,
     ) -> None:
         self.robot = robot
+        self.ground_rate_filter = ground_rate_filter
         self.base = base  # the base body, whose angles are ``<base>_roll`` ...
         self.data = robot.model.createData()
         self.names = tuple(state_names)
@@ -431,10 +434,14 @@ class StateMap:
         The rise is the platforms' mean estimated height (the feet's, from the IMU and the
         kinematics: no height map) over the first one seen, followed once beyond
         ``GROUND_DEADBAND_M`` (at once when each platform carries one foot) and low-passed
-        over ``GROUND_FILTER_S``; its rate, the
-        platforms' mean vertical velocity low-passed the same way, comes off the centre of
-        mass's (:meth:`state`), so that a rider rolling down a slope is not asked to stop
-        sinking with it. Without a board estimate nothing changes.
+        over ``GROUND_FILTER_S``; its rate, the platforms' mean vertical velocity low-passed
+        over ``ground_rate_filter`` (the same unless the pair sets it), comes off the centre
+        of mass's (:meth:`state`), so that a rider rolling down a slope is not asked to stop
+        sinking with it. A platform whose pitch swings (a Segway's firmware loop) swings its
+        vertical velocity up a slope, :math:`\\dot v \\sin\\alpha`; a rate lagged
+        beyond that swing's period keeps it out of the rider's vertical rate, while the
+        height, lagged as before, keeps the frame on the incline (lagged 1 s, it trailed the
+        Segway's 10 deg climb by 17 cm). Without a board estimate nothing changes.
 
         Returns:
             The frame's height :math:`\\Delta p_z` [m].
@@ -444,7 +451,9 @@ class StateMap:
         deck = sum(float(b.position[2]) for b in estimate.boards) / len(estimate.boards)
         if self._deck_start is None:
             self._deck_start, self._ground_time = deck, estimate.time
-        share = min(1.0, max(0.0, estimate.time - self._ground_time) / GROUND_FILTER_S)
+        elapsed = max(0.0, estimate.time - self._ground_time)
+        share = min(1.0, elapsed / GROUND_FILTER_S)
+        rate_share = min(1.0, elapsed / self.ground_rate_filter)
         self._ground_time = estimate.time
         rise = deck - self._deck_start
         feet = [len(b.feet) for b in estimate.boards]
@@ -460,6 +469,6 @@ class StateMap:
         sinking = 0.0
         if self._on_terrain:
             sinking = sum(float(b.velocity[2]) for b in estimate.boards) / len(estimate.boards)
-        self.ground_rate += share * (sinking - self.ground_rate)
+        self.ground_rate += rate_share * (sinking - self.ground_rate)
         self.frame = PlanarFrame(self.frame.yaw, self.frame.offset, height)
         return height
