@@ -179,6 +179,8 @@ def test_the_segways_frame_turns_with_the_lean_and_the_shoes_onto_their_lines() 
 class _Selector:
     """The pair's manoeuvres: ``wanted`` asked for, its phase matched at ``start``."""
 
+    holds_speed = False  # no speed loop over re-pushes: the loop's gain stays 0
+
     def __init__(self, wanted: Any, repushed: Any = None) -> None:
         self.wanted, self.repushed = wanted, repushed
         self.phases: list[float] = []
@@ -186,7 +188,9 @@ class _Selector:
     def select(self, command: Any, manoeuvre: Any, now: float, speed: float) -> Any:
         return manoeuvre if self.wanted is None else self.wanted
 
-    def repush(self, command: Any, manoeuvre: Any, now: float, speed: float) -> Any:
+    def repush(
+        self, command: Any, manoeuvre: Any, now: float, speed: float, gain: float = 0.0
+    ) -> Any:
         return manoeuvre if self.repushed is None else self.repushed
 
     def phase_start(self, times: Any, speeds: Any, speed: float, now: float, *rest: Any) -> float:
@@ -200,6 +204,7 @@ class _Manoeuvre:
     target: float
     library_kind: str
     start: float = 0.0
+    gain: float = 0.0
 
 
 def _choice(selector: _Selector) -> tuple[ManoeuvreChoice, list[tuple[str, float]]]:
