@@ -86,3 +86,35 @@ def board_estimate(t: float, boards: tuple[BoardEstimate, ...]) -> EstimatedStat
         foot_velocity=np.zeros((2, 3)),
         boards=boards,
     )
+
+
+def reference_problem(
+    x0: np.ndarray,
+    window: np.ndarray,
+    dt: float,
+    nu: int = 2,
+    contacts: tuple = (),
+    bound: float = 1.0,
+):
+    """An MPC problem around the state reference ``window`` from ``x0``, its dynamics unused
+    (the identity, no inputs' effect), its inputs within ``bound`` and their reference zero."""
+    from ridempc.mpc.problem import MpcProblem
+
+    n, nx = len(window) - 1, len(x0)
+    return MpcProblem(
+        initial_state=x0,
+        A=np.tile(np.eye(nx), (n, 1, 1)),
+        B=np.zeros((n, nx, nu)),
+        c=np.zeros((n, nx)),
+        state_reference=window,
+        input_reference=np.zeros((n, nu)),
+        state_weights=np.ones(nx),
+        input_weights=np.ones(nu),
+        input_lower=-np.full((n, nu), bound),
+        input_upper=np.full((n, nu), bound),
+        constraint_matrix=np.zeros((n, 0, nu)),
+        constraint_lower=np.zeros((n, 0)),
+        constraint_upper=np.zeros((n, 0)),
+        dt=dt,
+        contacts=contacts,
+    )

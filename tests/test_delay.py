@@ -58,7 +58,7 @@ def test_a_late_plan_starts_at_its_take_up(dog, monkeypatch) -> None:
 
         def adopting(solve, built, rider=rider, adopt=adopt, taken=taken):
             adopt(solve, built)
-            taken.append((rider._tick, rider._plan_time))
+            taken.append((rider._tick, rider.book.time))
 
         rider._adopt = adopting
         scenario = resolve_scenario("stand-still", "skateboard").with_duration(0.2)

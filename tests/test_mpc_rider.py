@@ -67,7 +67,7 @@ def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog)
 
     def adopting(solve, built):
         adopt(solve, built)
-        taken.append((rider._tick, solve.time, rider._plan_time))
+        taken.append((rider._tick, solve.time, rider.book.time))
         forked.append(rider._worker is not None)
 
     rider._adopt = adopting
@@ -270,7 +270,7 @@ def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> N
 
     def planning(solve, built):  # each plan as it takes over, with its problem
         adopt(solve, built)
-        problem, plan = built.problem, rider._plan
+        problem, plan = built.problem, rider.book.plan
         x0, reference = problem.initial_state, problem.state_reference[0]
         steps.append(
             (
@@ -344,7 +344,7 @@ def test_a_push_off_reaches_its_target_and_coasts_on(dog, seed: int) -> None:
 
     def recording(estimate, command, now):
         mpc_tick(estimate, command, now)
-        problem = rider._last_problem
+        problem = rider.book.problem
         if rider._coasting(rider.manoeuvre.reference_time(now)):
             coasting.append((now, problem.state_reference[0, n["board_v"]], rider._speed(estimate)))
 
@@ -486,7 +486,7 @@ def test_cassie_stands_on_the_hovershoes_with_a_soft_joint_pd(monkeypatch) -> No
     she stands: with the pair's terminal factor (30) her plans bring her back to the
     reference, at 10 they let her roll back at 0.05 m/s. The MPC from the start (not the
     pair's PD start, ``takeover``: its switch's transient is not what is measured here)."""
-    monkeypatch.setattr("ridempc.mpc.rider.start_readiness", lambda *args: None)
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
     cassie = load_robot("cassie")
     rider = MpcRider(cassie, "hovershoes")
     assert rider.pair.description.wbc.tracking_gain_scale == pytest.approx(0.1)

@@ -15,6 +15,7 @@ from ridempc.trajopt.schedule import push_schedule
 from ridempc.trajopt.skate_pair import REPUSH_GAIN, repush_entry, skate_models
 from ridempc.trajopt.skate_problem import initial_skate_state
 from ridempc.trajopt.skateboard import BOARD_STATE
+from tests.helpers import reference_problem
 
 
 def test_a_rolling_start_needs_the_strides_of_the_speed_it_gains() -> None:
@@ -77,23 +78,7 @@ def test_the_rider_pushes_again_once_the_board_has_slowed() -> None:
 
 def _problem(x0: np.ndarray, window: np.ndarray, dt: float) -> MpcProblem:
     """An MPC problem around the state reference ``window`` (its dynamics unused)."""
-    n, nx, nu = len(window) - 1, len(x0), 2
-    return MpcProblem(
-        initial_state=x0,
-        A=np.tile(np.eye(nx), (n, 1, 1)),
-        B=np.zeros((n, nx, nu)),
-        c=np.zeros((n, nx)),
-        state_reference=window,
-        input_reference=np.zeros((n, nu)),
-        state_weights=np.ones(nx),
-        input_weights=np.ones(nu),
-        input_lower=-np.ones((n, nu)),
-        input_upper=np.ones((n, nu)),
-        constraint_matrix=np.zeros((n, 0, nu)),
-        constraint_lower=np.zeros((n, 0)),
-        constraint_upper=np.zeros((n, 0)),
-        dt=dt,
-    )
+    return reference_problem(x0, window, dt)
 
 
 def test_a_switched_reference_is_blended_in_from_the_rider_before_the_first_push() -> None:

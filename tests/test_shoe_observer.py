@@ -137,7 +137,7 @@ def test_cassie_rides_shoes_staggered_under_her_feet(monkeypatch: pytest.MonkeyP
     (docs/tuning.md, h-ride), whose ride the observer does not fit, and the start is not
     held on the PD (the pair's ``takeover`` stage, mpc/readiness.py)."""
     monkeypatch.setattr("ridempc.mpc.stages.triggers.HANDOVER_DEVIATION", math.inf)
-    monkeypatch.setattr("ridempc.mpc.rider.start_readiness", lambda *args: None)
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
     cassie = load_robot("cassie")
     board = load_board("hovershoes")
     scenario = resolve_scenario("offset-start", "hovershoes").with_duration(1.5)

@@ -1,7 +1,8 @@
 """The protocols of the rider's stages (:class:`~ridempc.mpc.rider.MpcRider`'s loop).
 
 Each per-pair mechanism the pair file names under ``[stages.*]`` is a stage of one of these
-kinds, and the rider lists and orders them in one place (``MpcRider._build_stages``):
+kinds, and the rider lists and orders them in one place
+(:meth:`~ridempc.mpc.rider_parts.RiderParts._build_stages`):
 
 - :class:`TickObserver`: updated every control tick (500 Hz) from the sensors, the estimate
   and the feet's loads (``observers``: the drop's watch, the payload's loads), or, in
@@ -18,14 +19,19 @@ kinds, and the rider lists and orders them in one place (``MpcRider._build_stage
 - the command sources: the manoeuvre the command asks for
   (:class:`~ridempc.mpc.stages.manoeuvre_choice.ManoeuvreChoice`) and the commands read
   over the horizon (:class:`~ridempc.mpc.stages.commands.CommandHorizon`), the deck's roll
-  held to the stance (:class:`~ridempc.mpc.stages.deck_roll.StanceRoll`);
+  held to the stance (:class:`~ridempc.mpc.stages.deck_roll.StanceRoll`), and the
+  commanded roll and turn with the state in the library frame moved onto the board
+  (:class:`~ridempc.mpc.stages.frame_follow.CommandedFrame`);
+- the plans' observer: the handover's bookkeeping at each plan's take-up
+  (:class:`~ridempc.mpc.stages.plan_watch.PlanWatch`);
 - :class:`~ridempc.mpc.stages.triggers.HandoverTrigger` (``triggers``): why the MPC
   cannot ride this tick (:mod:`~ridempc.mpc.stages.triggers`), asked in order; a watch
   that observes every tick may be a trigger too.
 
 To add a stage: write its module (one concept, its physics in the docstring), a class
-meeting the protocol, build it in ``MpcRider.__init__`` from the pair file's stage (None when
-the pair does not name it) and add it to its protocol's list in ``_build_stages`` (or
+meeting the protocol, build it in ``RiderParts.__init__`` (:mod:`ridempc.mpc.rider_parts`)
+from the pair file's stage (None when the pair does not name it) and add it to its
+protocol's list in ``_build_stages`` (or
 ``_drift_sources``, ``_problem_shapers``, :func:`~ridempc.mpc.stages.triggers.handover_triggers`)
 in the order it acts.
 """

@@ -3,18 +3,22 @@
 The loop copies what it has at the MPC's tick into :class:`BuildInputs`; the problem is
 built, shaped (:class:`~ridempc.mpc.stages.base.ProblemShaper`) and solved from it in the
 tick, the solver thread or the solver process (:mod:`ridempc.mpc.solver_process`), which
-sends back a :class:`Built`; the loop holds the solve under way as a :class:`PendingSolve`
-until its plan takes over.
+sends back a :class:`Built` (:func:`build_and_run`); the loop holds the solve under way as
+a :class:`PendingSolve` until its plan takes over (:mod:`ridempc.mpc.plan_solver`).
 """
 
 from __future__ import annotations
 
+import time
+from collections.abc import Iterable
 from concurrent.futures import Future
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.mpc.delay import predicted_start
+from ridempc.mpc.handover import deviation
 from ridempc.mpc.lean import LeanSteering
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.problem import MpcProblem
@@ -24,7 +28,11 @@ from ridempc.mpc.solver_process import Reply
 from ridempc.mpc.state_map import PlanarFrame
 from ridempc.trajopt.schedule import Contact
 
-__all__ = ["BuildInputs", "Built", "PendingSolve"]
+if TYPE_CHECKING:
+    from ridempc.mpc.controller import LinearMpc
+    from ridempc.mpc.stages.base import ProblemShaper
+
+__all__ = ["BuildInputs", "Built", "PendingSolve", "build_and_run"]
 
 Array = NDArray[np.float64]
 
@@ -88,3 +96,38 @@ class PendingSolve(NamedTuple):
     time: float
     due: int
     reply: Future[Built] | Reply[Built] | None = None
+
+
+def build_and_run(mpc: LinearMpc, shapers: Iterable[ProblemShaper], inputs: BuildInputs) -> Built:
+    """The MPC problem of one tick built from ``inputs`` (and the build's own state: the QP
+    and its warm start, a re-push's blend, the crouch's start, the static shifts kept by
+    key), shaped by ``shapers`` in order and solved; in the loop's tick, the solver thread
+    or the solver process, the same either way. A plan taken up ``inputs.delay`` [s] late
+    starts from the state predicted at its take-up (:func:`~ridempc.mpc.delay.predicted_start`)."""
+    started = time.perf_counter()
+    if inputs.reference is not None:
+        mpc.reference = inputs.reference
+    x0 = inputs.x0
+    if inputs.delay > 0.0 and inputs.first_input is not None:
+        x0 = predicted_start(
+            mpc.model,
+            mpc.reference,
+            inputs.t_ref,
+            x0,
+            inputs.first_input,
+            inputs.drift,
+            inputs.delay,
+            mpc.settings.dt,
+        )
+    problem = mpc.problem(inputs.t_ref, x0, inputs.drift)
+    for shaper in shapers:
+        problem = shaper(problem, inputs)
+    if mpc.qp is None:
+        mpc.qp = mpc.build_qp(problem)
+    build = time.perf_counter() - started
+    qp = mpc.qp
+    plan = qp.finish(qp.start(problem), qp.run())
+    weights, reference = problem.state_weights, problem.state_reference
+    gap = deviation(problem.initial_state, reference[0], weights)
+    expected = deviation(plan.states[1], reference[1], weights)
+    return Built(plan, problem.contacts[0], build, qp.failures, problem, gap, expected)
