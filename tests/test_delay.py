@@ -47,7 +47,7 @@ def test_a_late_plan_starts_at_its_take_up(dog, monkeypatch) -> None:
     tick it takes over, its start predicted there; without the prediction it is timed
     from the tick its state was estimated (the plan's time shifted), a different ride
     (the MPC from the first tick, not after the pair's PD start)."""
-    monkeypatch.setattr("ridempc.mpc.rider.start_readiness", lambda *args: None)
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
     rides = {}
     for predicts in (True, False):
         rider = MpcRider(dog, "skateboard", plan_latency=2)

@@ -42,7 +42,7 @@ def _ride(dog, duration: float, rider: MpcRider | None = None):
 def mpc_from_start(monkeypatch):
     """The MPC rides from the first tick, not after the pair's PD start (``takeover``): what
     these tests read is the MPC's own ride and handovers from rest."""
-    monkeypatch.setattr("ridempc.mpc.rider.start_readiness", lambda *args: None)
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
 
 
 @pytest.mark.usefixtures("mpc_from_start")
