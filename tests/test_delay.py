@@ -42,10 +42,12 @@ def test_the_start_is_the_state_carried_over_the_delay_by_the_reduced_model(dog)
     np.testing.assert_allclose(without, x0 + delay * rates, rtol=1e-12, atol=1e-12)
 
 
-def test_a_late_plan_starts_at_its_take_up(dog) -> None:
+def test_a_late_plan_starts_at_its_take_up(dog, monkeypatch) -> None:
     """With a ``plan_latency`` every plan but the first (waited for) is timed from the
     tick it takes over, its start predicted there; without the prediction it is timed
-    from the tick its state was estimated (the plan's time shifted), a different ride."""
+    from the tick its state was estimated (the plan's time shifted), a different ride
+    (the MPC from the first tick, not after the pair's PD start)."""
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
     rides = {}
     for predicts in (True, False):
         rider = MpcRider(dog, "skateboard", plan_latency=2)

@@ -38,6 +38,14 @@ def _ride(dog, duration: float, rider: MpcRider | None = None):
     return Simulation(scene, rider, scenario).run(), rider
 
 
+@pytest.fixture
+def mpc_from_start(monkeypatch):
+    """The MPC rides from the first tick, not after the pair's PD start (``takeover``): what
+    these tests read is the MPC's own ride and handovers from rest."""
+    monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
+
+
+@pytest.mark.usefixtures("mpc_from_start")
 def test_each_plan_takes_over_the_tick_after_its_state_and_the_ride_repeats(dog) -> None:
     """With ``plan_latency`` 1 the MPC builds and solves its problems in a thread of its
     own (from ``PROCESS_MIN_LATENCY`` ticks on in a process): a plan takes over one tick
@@ -109,6 +117,7 @@ def test_stands_on_the_skateboard(tmp_path) -> None:
     assert summary["estimator_velocity_rmse"] < 0.05
 
 
+@pytest.mark.usefixtures("mpc_from_start")
 def test_a_failing_wbc_hands_the_ride_to_the_pd_and_back(dog, tmp_path, monkeypatch) -> None:
     """The whole-body QP fails from 0.3 to 0.5 s (a test hook in place of the solver): the
     ride goes to the pair's PD at the first failure, blended, never frozen, and back to the
@@ -135,6 +144,7 @@ def test_a_failing_wbc_hands_the_ride_to_the_pd_and_back(dog, tmp_path, monkeypa
     assert fallback["duration_s"] == pytest.approx(back, abs=0.01)
 
 
+@pytest.mark.usefixtures("mpc_from_start")
 def test_a_state_estimate_gone_non_finite_hands_the_ride_to_the_pd(dog) -> None:
     """A NaN in the estimate (a sensor fault, a diverged filter) never reaches the MPC or
     the WBC: the PD, with its own estimator, rides on from that tick, and the summary says
@@ -162,6 +172,7 @@ def test_a_state_estimate_gone_non_finite_hands_the_ride_to_the_pd(dog) -> None:
     assert np.max(np.abs(joints[-1] - joints[len(joints) // 2])) < 0.2  # still balancing
 
 
+@pytest.mark.usefixtures("mpc_from_start")
 def test_a_corrupt_library_entry_met_mid_ride_hands_the_ride_to_the_pd(dog, tmp_path, monkeypatch):
     """push-off-0.5 picks up accelerate-0.50 when the command comes (0.5 s); with that file
     corrupt, the PD rides on, and the summary names the file."""
@@ -233,6 +244,7 @@ def test_a_planned_roll_is_read_ahead_over_the_horizon(dog) -> None:
     assert np.abs(blind - wanted).max() > 0.005  # [rad] the extrapolation misses the bend
 
 
+@pytest.mark.usefixtures("mpc_from_start")
 def test_a_push_off_lifts_the_pushing_foot_and_stands_it_on_the_ground(dog) -> None:
     """The schedule's swing foot follows the reference's foot down to the ground, on time,
     and while it pushes it stands on the ground: out of the deck's estimate, not a fall.
