@@ -54,14 +54,6 @@ and keeps the foot at its last loaded pitch in the world, the leg lengthens to f
 shoe down, and the CoP law reads the CoM x over the feet held at its last loaded value.
 On flat ground no shin relaxes and the law above is the paper's.
 
-Beside the MPC, as its backup, the PD is lent the rider's drop watch (:attr:`shoes_falling`,
-:mod:`ridempc.mpc.backup_reach`): a shin also relaxes when a push tips the rider onto the
-other shoe, and the MPC, leaning against the push before it hands the ride over, holds that
-foot unloaded longer than the PD's own ride does, so that its leg reaches down, up to its
-whole stroke, after a shoe that never fell. So lent a witness, a leg reaches down only once
-the witness has told a drop since the feet were last both loaded; riding alone (no
-witness), the PD is the paper's.
-
 The controller runs the state estimator every tick with one platform per foot (left foot
 on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Gains:
 ``cassie_hovershoes.toml`` (:mod:`ridempc.baselines.hovershoe_gains`).
@@ -70,7 +62,6 @@ on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Ga
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -116,14 +107,7 @@ class CassieHovershoes(CassieStanding):
 
     Raises:
         ConfigError: The gain file is malformed, or the robot lacks Cassie's joints or feet.
-
-    Attributes:
-        shoes_falling: Whether the shoes are seen falling away this tick, from outside the
-            legs' loads (a drop watch lent by the law this one stands by for); None: the
-            shin springs alone tell a shoe in the air, as riding alone.
     """
-
-    shoes_falling: Callable[[], bool] | None = None
 
     def __init__(
         self,
@@ -151,7 +135,6 @@ class CassieHovershoes(CassieStanding):
         self._time = 0.0
         self._extension = np.zeros(2)  # each leg's length added to reach its falling shoe [m]
         self._unloaded_for = np.zeros(2)  # how long each foot has been unloaded [s]
-        self._drop_seen = False  # shoes_falling told a drop since both feet were loaded
 
     # ------------------------------------------------------------------ state
 
@@ -166,7 +149,6 @@ class CassieHovershoes(CassieStanding):
         self._loaded_com_x[:] = 0.0
         self._extension[:] = 0.0
         self._unloaded_for[:] = 0.0
-        self._drop_seen = False
         self._loaded_pitch = self._foot_pitches(self.kinematic_state(sensors))
         for low_pass in (
             self._speed_filter,
@@ -332,11 +314,6 @@ class CassieHovershoes(CassieStanding):
             return state
         self._unloaded_for = np.where(self._unloaded, self._unloaded_for + dt, 0.0)
         falling = self._unloaded_for >= gains.reach_delay
-        if self.shoes_falling is not None:
-            self._drop_seen = bool(self._unloaded.any()) and (
-                self._drop_seen or self.shoes_falling()
-            )
-            falling &= self._drop_seen
         reach = np.where(falling, gains.extend_speed, -self.gains.legs.max_speed)
         reach[self._unloaded & ~falling] = 0.0
         self._extension = np.clip(self._extension + reach * dt, 0.0, gains.max_extension)

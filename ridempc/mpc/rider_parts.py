@@ -15,7 +15,6 @@ from __future__ import annotations
 from ridempc.boards.canonical import board_state_columns
 from ridempc.controllers.base import Controller
 from ridempc.estimation import StateEstimator
-from ridempc.mpc.backup_reach import lend_drop_watch
 from ridempc.mpc.controller import LinearMpc, MpcSettings
 from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.flight import DropFlight
@@ -246,7 +245,6 @@ class RiderParts(Controller):
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)
         shared = share_estimator(law, self.estimator)  # one filter for both
-        lend_drop_watch(law, self.drop_watch)  # its legs reach after a drop, not a push
         # the backup's standby in full every tick while the MPC is on its first probation, in
         # the ride's first STANDBY_WARMUP_S: the backup's filters start there from rest, and
         # at 33 Hz over the first 0.06 s they had not caught up when handed the ride
