@@ -118,3 +118,21 @@ def reference_problem(
         dt=dt,
         contacts=contacts,
     )
+
+
+def osqp_tight(
+    p: np.ndarray, q: np.ndarray, a: np.ndarray, lower: np.ndarray, upper: np.ndarray
+) -> np.ndarray:
+    """The dense QP :math:`\\min \\tfrac12 z^\\top P z + q^\\top z`, :math:`l \\le A z \\le u`
+    solved by OSQP to 1e-10 and polished: the reference optimum."""
+    import osqp
+    import scipy.sparse as sp
+
+    solver = osqp.OSQP()
+    solver.setup(
+        sp.csc_matrix(np.triu(p)), q, sp.csc_matrix(a), lower, upper,
+        eps_abs=1e-10, eps_rel=1e-10, max_iter=100_000, polishing=True, verbose=False,
+    )  # fmt: skip
+    result = solver.solve(raise_error=False)
+    assert result.info.status == "solved"
+    return np.asarray(result.x)

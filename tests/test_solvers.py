@@ -6,15 +6,14 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import osqp
 import pytest
-import scipy.sparse as sp
 
 from ridempc.errors import UnknownNameError
 from ridempc.mpc.controller import LinearMpc
 from ridempc.mpc.qp import MpcQP
 from ridempc.solvers import QP_KINDS, solve_dense, solver_for
 from ridempc.wbc.settings import SOLVERS, WbcSettings
+from tests.helpers import osqp_tight
 
 
 class _Dense(NamedTuple):
@@ -23,17 +22,6 @@ class _Dense(NamedTuple):
     A: np.ndarray
     l: np.ndarray  # noqa: E741 - the QP's usual name
     u: np.ndarray
-
-
-def _osqp(p: np.ndarray, q: np.ndarray, a: np.ndarray, lower: np.ndarray, upper: np.ndarray):
-    solver = osqp.OSQP()
-    solver.setup(
-        sp.csc_matrix(np.triu(p)), q, sp.csc_matrix(a), lower, upper,
-        eps_abs=1e-10, eps_rel=1e-10, max_iter=100_000, polishing=True, verbose=False,
-    )  # fmt: skip
-    result = solver.solve(raise_error=False)
-    assert result.info.status == "solved"
-    return result.x
 
 
 def _small_dense_qp(seed: int) -> _Dense:
@@ -53,7 +41,7 @@ def test_the_wbc_solver_finds_osqps_optimum(seed: int) -> None:
     problem = _small_dense_qp(seed)
     answer = solve_dense(solver_for("wbc"), problem)
     assert answer.found and answer.x is not None and answer.seconds > 0.0
-    reference = _osqp(problem.P, problem.q, problem.A, problem.l, problem.u)
+    reference = osqp_tight(problem.P, problem.q, problem.A, problem.l, problem.u)
     assert answer.x == pytest.approx(reference, abs=1e-6)
     ax = problem.A @ answer.x
     assert np.all(ax >= problem.l - 1e-9) and np.all(ax <= problem.u + 1e-9)
@@ -69,7 +57,7 @@ def test_the_mpc_solver_finds_osqps_optimum() -> None:
     assert plan.status == "solved"
     p, a = qp.matrices(problem)
     lower, upper = qp.bounds(problem)
-    z = _osqp(p.toarray(), np.zeros(p.shape[0]), a.toarray(), lower, upper)
+    z = osqp_tight(p.toarray(), np.zeros(p.shape[0]), a.toarray(), lower, upper)
     n = (qp.horizon + 1) * qp.nx
     u0 = problem.input_reference[0] + qp._scale[n : n + qp.nu] * z[n : n + qp.nu]
     tolerance = qp._scale[n : n + qp.nu]

@@ -46,6 +46,7 @@ from numpy.typing import NDArray
 from ridempc.interrupts import osqp_returned
 from ridempc.mpc.plan import Plan, shift_plan
 from ridempc.mpc.problem import MpcProblem
+from ridempc.mpc.row_classes import RowClasses
 
 __all__ = [
     "DEFAULT_SETTINGS",
@@ -205,12 +206,16 @@ class MpcQP:
             state_scale: Typical size of each state's deviation (nx, default ones).
             input_scale: Typical size of each input's deviation (nu, default ones), e.g.
                 the weight per contact [N] for the forces.
-            settings: OSQP settings over :data:`DEFAULT_SETTINGS`.
+            settings: OSQP settings over :data:`DEFAULT_SETTINGS`, and ``row_classes``:
+                True (default) holds each row in one OSQP class
+                (:mod:`~ridempc.mpc.row_classes`: new bounds never re-factor the KKT
+                matrix), False gives each row the class its bounds ask for.
         """
         self.horizon, self.nx, self.nu = problem.horizon, problem.nx, problem.nu
         self.n_constraints = problem.n_constraints
         self.structure = structure or QPStructure.of(problem)
         self._check_structure()
+        held = bool(settings.pop("row_classes", True))
         self.settings = {**DEFAULT_SETTINGS, **settings}
         limit = self.settings.get("time_limit")
         self.time_limit: float | None = None if limit is None else float(limit)
@@ -244,6 +249,7 @@ class MpcQP:
         _, lower, upper = self._data(problem)
         self._solver = osqp.OSQP()
         self._solver.setup(hessian, np.zeros(self.n_variables), csc, lower, upper, **self.settings)
+        self.row_classes = RowClasses(lower, upper, self._indices) if held else None
 
     @property
     def n_variables(self) -> int:
@@ -458,6 +464,8 @@ class MpcQP:
         """
         self._check_sizes(problem)
         values, lower, upper = self._data(problem)
+        if self.row_classes is not None:
+            values, lower, upper = self.row_classes.hold(values, lower, upper)
         return _Update(self._weights(problem), values, lower, upper, None, None)
 
     def _write(self, update: _Update) -> None:
