@@ -40,7 +40,10 @@ For each robot-board pair with a pair file (:func:`ridempc.mpc.pairs.mpc_pair_na
    qpsolvers backends (``proxqp``, ``daqp``, ... with equality rows :math:`l = u` as
    equalities) and HPIPM through CasADi's ``conic`` interface (in its stage-wise OCP
    layout, see :func:`_stage_layout`); each is timed from a cold start per problem (no
-   warm start, only the solve call), and its objective compared with OSQP's.
+   warm start, only the solve call), and its objective compared with OSQP's; and OSQP
+   warm-started as in step 2 with each row in the class its bounds give it
+   (``osqp, row classes by bounds``: the loop's QP holds each row in one class,
+   :mod:`ridempc.mpc.row_classes`), its first inputs compared with the loop QP's.
 
 The JSON's ``controller_tick_p99_ms`` is the p99 of the rider's whole update per control
 tick (estimator, MPC share, WBC and the rest), ``mpc_tick_p99_ms`` the MPC tick's (build
@@ -95,6 +98,7 @@ __all__ = ["PairBench", "bench", "bench_table"]
 
 DEFAULT_SECONDS: float = 6.0
 PASSES: int = 3  # the recorded problems are solved this many times (module docstring)
+OSQP_BOUNDS_CLASSES: str = "osqp, row classes by bounds"  # the loop's OSQP before held classes
 
 
 @dataclass
@@ -617,12 +621,13 @@ def bench_pair(
         out.profile_by_tick = profiler.hottest_by_kind(DEFAULT_TOP)
     if problems:
         mpc = LinearMpc(rider.pair, rider.mpc.reference, rider.mpc.model, rider.mpc.settings)
-        times, qp = _mpc_pass(mpc, problems)
+        times, qp, first_inputs = _mpc_pass(mpc, problems)
         passes = [times] + [_mpc_pass(mpc, problems)[0] for _ in range(PASSES - 1)]
         out.mpc_solve_median_ms, out.mpc_solve_p99_ms = _stats(times)
         out.mpc_solve_best_p99_ms = _best_p99(passes)
         out.solvers = _other_solvers(qp, problems)
         out.solvers["osqp"] = {**_figures(times, [0.0], int(qp.failures)), "warm_started": True}
+        out.solvers[OSQP_BOUNDS_CLASSES] = _classes_by_bounds(mpc, problems, first_inputs)
     if wbc_inputs:
         times, solved, out.wbc_failures = _wbc_pass(rider, wbc_inputs)
         passes = [times] + [_wbc_pass(rider, wbc_inputs)[0] for _ in range(PASSES - 1)]
@@ -661,17 +666,28 @@ def _best_p99(passes: Sequence[Sequence[float]]) -> float:
     return _stats(np.min(passes, axis=0).tolist())[1]
 
 
-def _mpc_pass(mpc: Any, problems: list) -> tuple[list[float], Any]:
+def _mpc_pass(mpc: Any, problems: list, **osqp: Any) -> tuple[list[float], Any, Any]:
     """The recorded MPC problems solved in order by a fresh QP (the same warm starts, the
-    same work in every pass): each solve's wall time [s], and the QP."""
-    qp = mpc.build_qp(problems[0])
-    times = []
+    same work in every pass; ``osqp`` over its settings): each solve's wall time [s], the
+    QP, and the plans' first inputs in units of their tolerances (one row per problem)."""
+    qp = mpc.build_qp(problems[0], **osqp)
+    times, first_inputs = [], []
     with frozen_heap():  # the recorded problems are not the controller's to collect
         for problem in problems:
             started = time.perf_counter()
-            qp.solve(problem)
+            plan = qp.solve(problem)
             times.append(time.perf_counter() - started)
-    return times, qp
+            first_inputs.append(plan.first_input)
+    return times, qp, np.asarray(first_inputs) / qp._input_scale
+
+
+def _classes_by_bounds(mpc: Any, problems: list, first_inputs: Any) -> dict[str, Any]:
+    """OSQP warm-started as :func:`_mpc_pass` with each row in the class its bounds give it
+    (:mod:`~ridempc.mpc.row_classes` off): its times, and the largest difference of its
+    first inputs from the loop's QP's [tolerances]."""
+    times, qp, inputs = _mpc_pass(mpc, problems, row_classes=False)
+    diffs = np.max(np.abs(inputs - first_inputs), axis=1).tolist()
+    return {**_figures(times, [0.0], int(qp.failures), diffs), "warm_started": True}
 
 
 def _wbc_copy(rider: Any, solver: str | None = None) -> Any:

@@ -115,6 +115,11 @@ def test_the_wbc_is_timed_as_the_rider_runs_it() -> None:
     # each problem's fastest pass: never slower than the first pass, at the p99 as well
     assert 0.0 < out.wbc_solve_best_p99_ms <= out.wbc_solve_p99_ms
     assert 0.0 < out.mpc_solve_best_p99_ms <= out.mpc_solve_p99_ms
+    # OSQP with the rows' classes from their bounds: the Segway's never change, same plans
+    from ridempc.bench import OSQP_BOUNDS_CLASSES
+
+    classes_by_bounds = out.solvers[OSQP_BOUNDS_CLASSES]
+    assert classes_by_bounds["failures"] == 0 and classes_by_bounds["first_input_diff_max"] == 0.0
     # the closed loop's budget: its parts add up to the loop's wall time per tick
     from ridempc.bench import BUDGET_PARTS
 
