@@ -304,6 +304,10 @@ class MpcQP:
         self._a_rows, self._a_cols = np.nonzero(s.state_pattern)
         self._b_rows, self._b_cols = np.nonzero(s.input_pattern)
         self._g_rows, self._g_cols = np.nonzero(s.constraint_pattern)
+        # each pattern's entries as flat indices of its matrix (one take per stack)
+        self._a_at = np.flatnonzero(s.state_pattern)
+        self._b_at = np.flatnonzero(s.input_pattern)
+        self._g_at = np.flatnonzero(s.constraint_pattern)
         for k in range(n):
             rows.append(nx + k * nx + self._a_rows)
             cols.append(x_at[k] + self._a_cols)
@@ -319,6 +323,7 @@ class MpcQP:
         self._source = order  # value-vector index of each CSC entry
         self._indices = all_rows[order].astype(np.int64)
         self._columns = all_cols[order]
+        self._column_scale = self._scale[self._columns]  # D at each stored entry
         counts = np.bincount(all_cols, minlength=self.n_variables)
         self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         self._ones = np.ones(n_ones)
@@ -367,12 +372,12 @@ class MpcQP:
         values = np.concatenate(
             [
                 self._ones,
-                -problem.A[:, self._a_rows, self._a_cols].ravel(),
-                -problem.B[:, self._b_rows, self._b_cols].ravel(),
-                g[:, self._g_rows, self._g_cols].ravel(),
+                -problem.A.reshape(len(g), -1).take(self._a_at, axis=1).ravel(),
+                -problem.B.reshape(len(g), -1).take(self._b_at, axis=1).ravel(),
+                g.reshape(len(g), -1).take(self._g_at, axis=1).ravel(),
             ]
         )[self._source]
-        values *= self._scale[self._columns] * row_scale[self._indices]
+        values *= self._column_scale * row_scale[self._indices]
         x_ref, u_ref = problem.state_reference, problem.input_reference
         at_reference = np.concatenate(
             [
