@@ -26,10 +26,11 @@ The sparsity of :math:`A_{qp}` is fixed when the QP is built: the structural non
 :math:`A_k`, :math:`B_k` and :math:`G_k` (from the pair's Jacobians and the pyramids, see
 :class:`QPStructure`), stored even where a value happens to be zero. An update writes the
 new values into that pattern (``Px``, ``Ax``, ``l``, ``u`` of OSQP's ``update``),
-OSQP is set up once, and each solve is warm-started from the previous plan shifted by one
-step (primal and dual). A solve that does not end ``solved`` within the iteration budget
-(or an optional wall-clock time limit) returns the previous plan shifted by one step,
-flagged as a fallback, and counts as a failure.
+OSQP is set up once, each row held in one OSQP class (:mod:`ridempc.mpc.row_classes`, so
+that new bounds never re-factor the KKT matrix), and each solve is warm-started from the
+previous plan shifted by one step (primal and dual). A solve that does not end ``solved``
+within the iteration budget (or an optional wall-clock time limit) returns the previous
+plan shifted by one step, flagged as a fallback, and counts as a failure.
 """
 
 from __future__ import annotations
@@ -187,6 +188,7 @@ class MpcQP:
         structure: The fixed sparsity.
         history: One :class:`SolveRecord` per :meth:`solve`.
         failures: Solves that fell back.
+        row_classes: The rows' OSQP classes as held (None: as the bounds give them).
     """
 
     def __init__(
