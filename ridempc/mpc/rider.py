@@ -63,7 +63,6 @@ from ridempc.mpc.manoeuvre import HOLD, REPUSH, REPUSH_BAND
 from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
 from ridempc.mpc.push_handover import deviation_deferred
-from ridempc.mpc.push_steer import steering_nodes
 from ridempc.mpc.rider_parts import BACKUP_LAW, MPC_DIVIDER
 from ridempc.mpc.rider_reports import RiderReports
 from ridempc.mpc.stages.base import ControlTick, MpcTick
@@ -279,11 +278,8 @@ class MpcRider(RiderReports):
         )
         if self.payload_models is not None:
             self.payload_models.absorb(tick)
-        steering: bool | Array = balancing  # a re-push's strokes go straight (mpc/push_steer.py)
-        if not balancing and self.manoeuvre.kind == REPUSH:
-            settings = self.mpc.settings
-            nodes = settings.horizon + 1
-            steering = steering_nodes(self.mpc.reference, t_ref, nodes, settings.dt)
+        pushing = Contact.GROUND in self.book.contacts  # a foot on the ground goes straight
+        steering = balancing or (self.manoeuvre.kind == REPUSH and not pushing)
         if self.shoes is not None and self._slope_trim:  # a slope's lost speed: mpc/slope_trim.py
             riding, slopes = not self.handover.on_backup, self.shoes.slopes.angles
             self.shoes.trim.update(now, command.velocity, rider_speed, slopes, riding)
