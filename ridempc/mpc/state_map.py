@@ -203,7 +203,7 @@ class StateMap:
         self._stance: list[int] = []  # the most feet each platform's estimate was taken from
         self._fill = [self._filler(name) for name in self.names]
 
-    def _filler(self, name: str) -> tuple[str, int | str]:
+    def _filler(self, name: str) -> tuple[str, int | str | tuple[str, int, str]]:
         body = {"com_x": 0, "com_y": 1, "com_z": 2}
         if name in body:
             return ("com", body[name])
@@ -218,7 +218,9 @@ class StateMap:
             return ("joint", name[2:])
         if name in self.board_states:
             platform, quantity = self.board_states[name]
-            return ("board", f"{platform}:{quantity}")
+            key = f"{platform}:{quantity}"
+            index, field = key.split(":", 1)  # parsed once, not on each tick
+            return ("board", (key, int(index), field))
         raise ConfigError(f"MPC state map: cannot estimate state '{name}'")
 
     def reset(self) -> None:
@@ -232,12 +234,16 @@ class StateMap:
         self._heading_time = 0.0
 
     def _board_value(
-        self, key: str, boards: tuple[BoardEstimate, ...], time: float, origins: dict[int, Array]
+        self,
+        key: tuple[str, int, str],
+        boards: tuple[BoardEstimate, ...],
+        time: float,
+        origins: dict[int, Array],
     ) -> float:
-        """One board state of ``key`` (``platform:quantity``); ``origins`` holds each
-        platform's position in the library frame once found (one per :meth:`state`)."""
-        index, field = key.split(":", 1)
-        k = int(index)
+        """One board state of ``key`` (``platform:quantity``, the platform and the quantity);
+        ``origins`` holds each platform's position in the library frame once found (one per
+        :meth:`state`)."""
+        name, k, field = key
         if k >= len(boards):
             raise ConfigError(f"MPC state map: no estimate of platform {k}")
         board = boards[k]
@@ -257,11 +263,18 @@ class StateMap:
             return board.roll
         if field == "speed":
             return forward_speed(board)
-        angle = {"pitch_rate": board.pitch, "roll_rate": board.roll, "yaw_rate": board.yaw}
-        if field in angle:
-            rate = self._rates.setdefault(key, _AngleRate(RATE_FILTER_HZ))
-            return rate(time, angle[field])
-        raise ConfigError(f"MPC state map: unknown board state '{field}'")
+        if field == "pitch_rate":
+            angle = board.pitch
+        elif field == "roll_rate":
+            angle = board.roll
+        elif field == "yaw_rate":
+            angle = board.yaw
+        else:
+            raise ConfigError(f"MPC state map: unknown board state '{field}'")
+        rate = self._rates.get(name)
+        if rate is None:
+            rate = self._rates[name] = _AngleRate(RATE_FILTER_HZ)
+        return rate(time, angle)
 
     def state(self, estimate: EstimatedState) -> Array:
         """:math:`x_0` in the library frame, the pair's layout."""
@@ -288,7 +301,8 @@ class StateMap:
             elif kind == "joint":
                 x[i] = estimate.joint_position[str(key)]
             else:
-                x[i] = self._board_value(str(key), estimate.boards, estimate.time, origins)
+                assert isinstance(key, tuple)
+                x[i] = self._board_value(key, estimate.boards, estimate.time, origins)
         return x
 
     def com(self, estimate: EstimatedState) -> Array:
