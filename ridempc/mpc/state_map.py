@@ -201,9 +201,10 @@ class StateMap:
         self._ground_time = 0.0
         self.ground_rate = 0.0  # [m/s] the followed ground's rise rate
         self._stance: list[int] = []  # the most feet each platform's estimate was taken from
+        self._board_keys: dict[str, tuple[str, int, str]] = {}  # key: (key, platform, field)
         self._fill = [self._filler(name) for name in self.names]
 
-    def _filler(self, name: str) -> tuple[str, int | str | tuple[str, int, str]]:
+    def _filler(self, name: str) -> tuple[str, int | str]:
         body = {"com_x": 0, "com_y": 1, "com_z": 2}
         if name in body:
             return ("com", body[name])
@@ -220,7 +221,8 @@ class StateMap:
             platform, quantity = self.board_states[name]
             key = f"{platform}:{quantity}"
             index, field = key.split(":", 1)  # parsed once, not on each tick
-            return ("board", (key, int(index), field))
+            self._board_keys[key] = (key, int(index), field)
+            return ("board", key)
         raise ConfigError(f"MPC state map: cannot estimate state '{name}'")
 
     def reset(self) -> None:
@@ -301,8 +303,8 @@ class StateMap:
             elif kind == "joint":
                 x[i] = estimate.joint_position[str(key)]
             else:
-                assert isinstance(key, tuple)
-                x[i] = self._board_value(key, estimate.boards, estimate.time, origins)
+                parsed = self._board_keys[str(key)]
+                x[i] = self._board_value(parsed, estimate.boards, estimate.time, origins)
         return x
 
     def com(self, estimate: EstimatedState) -> Array:
