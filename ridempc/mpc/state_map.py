@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
@@ -128,20 +129,34 @@ class PlanarFrame:
         """:math:`R_z(\\Delta\\psi)`, library axes to world axes."""
         return self._rotation(1.0)
 
+    @cached_property
+    def _to_world(self) -> Array:
+        r""":math:`R_z(\Delta\psi)`, made once per frame (a frame is read several times a
+        tick) and never handed out."""
+        return self._rotation(1.0)
+
+    @cached_property
+    def _to_library(self) -> Array:
+        r""":math:`R_z(-\Delta\psi)`, made once per frame and never handed out."""
+        return self._rotation(-1.0)
+
+    @cached_property
+    def _shift(self) -> Array:
+        r""":math:`\Delta p` [m] as a vector, made once per frame and never handed out."""
+        return np.array([*self.offset, self.height])
+
     def point_to_library(self, p: Array) -> Array:
-        shifted = np.asarray(p, dtype=float) - np.array([*self.offset, self.height])
-        return self._rotation(-1.0).dot(shifted)
+        shifted = np.asarray(p, dtype=float) - self._shift
+        return self._to_library.dot(shifted)
 
     def vector_to_library(self, v: Array) -> Array:
-        return self._rotation(-1.0).dot(np.asarray(v, dtype=float))
+        return self._to_library.dot(np.asarray(v, dtype=float))
 
     def point_to_world(self, p: Array) -> Array:
-        return self._rotation(1.0).dot(np.asarray(p, dtype=float)) + np.array(
-            [*self.offset, self.height]
-        )
+        return self._to_world.dot(np.asarray(p, dtype=float)) + self._shift
 
     def vector_to_world(self, v: Array) -> Array:
-        return self._rotation(1.0).dot(np.asarray(v, dtype=float))
+        return self._to_world.dot(np.asarray(v, dtype=float))
 
 
 class _AngleRate:
