@@ -63,3 +63,23 @@ def test_plan_targets_match_the_per_coordinate_formulas(feedforward: float) -> N
             want["acceleration"] = want["angular_acceleration"] = np.zeros(3)
         for key, value in want.items():
             np.testing.assert_allclose(got[key], value, rtol=0, atol=1e-12, err_msg=key)
+
+
+@pytest.mark.parametrize("feedforward", [0.0, 0.5])
+def test_a_plan_read_again_gives_what_a_fresh_reader_gives(feedforward: float) -> None:
+    """The targets kept per plan and frame: the same plan read at other shares, then a new
+    plan and a new frame, each equal to the bit to a reader that never read before."""
+    rng = np.random.default_rng(12)
+    reader = PlanReader(INDEX, "base_", FORCE_INDEX, CONTACT_FOOT, 2, feedforward, DT)
+    plans = [
+        Plan(rng.normal(size=(3, len(NAMES))), inputs, inputs[0], "solved", 0.0, False)
+        for inputs in (50.0 * rng.normal(size=(2, 9)) for _ in range(2))
+    ]
+    frames = [PlanarFrame(float(rng.uniform(-np.pi, np.pi)), (0.1, -0.2)) for _ in range(2)]
+    for plan, frame in ((plans[0], frames[0]), (plans[0], frames[1]), (plans[1], frames[1])):
+        for share in (0.0, 0.4, 1.0):
+            got = reader(plan, frame, share)._asdict()
+            fresh = PlanReader(INDEX, "base_", FORCE_INDEX, CONTACT_FOOT, 2, feedforward, DT)
+            for key, value in fresh(plan, frame, share)._asdict().items():
+                assert np.array_equal(got[key], value), key
+    assert not reader(plans[1], frames[1], 0.5).forces.flags.writeable

@@ -173,3 +173,15 @@ def test_foot_points_are_the_mean_of_their_sites(model: WholeBodyModel) -> None:
         count = np.bincount(feet, minlength=len(model.foot_names))[:, None]
         sums = [np.bincount(feet, sites[:, k], len(model.foot_names)) for k in range(3)]
         np.testing.assert_array_equal(model.foot_points(q), np.stack(sums, 1) / count)
+
+
+def test_placed_foot_points_are_foot_points_bit_for_bit(model: WholeBodyModel) -> None:
+    """The feet's points from a data whose joints ``centerOfMass`` placed (the swing
+    targets' one pass over the joints) equal :meth:`WholeBodyModel.foot_points`' own pass,
+    bit for bit."""
+    rng = np.random.default_rng(14)
+    data = model.model.createData()
+    for _ in range(20):
+        q, _ = _random_state(model, rng)
+        pin.centerOfMass(model.model, data, q)
+        np.testing.assert_array_equal(model.placed_foot_points(data), model.foot_points(q))

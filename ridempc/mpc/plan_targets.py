@@ -17,7 +17,9 @@ solved in into the world by that frame's yaw :math:`\\Delta\\psi` and offset
 
 The state's rows are looked up once (:class:`PlanReader`), so that a tick costs a handful of
 array operations rather than one per coordinate (products by ``.dot``: NumPy 2's ``@`` costs
-some 2 us more a call on 3-vectors).
+some 2 us more a call on 3-vectors). What does not change through the step (the frame's turn,
+the forces, the centre of mass's feedforward) is read once per plan and frame, on the first
+tick that reads them (:class:`_Steady`), and handed out read-only.
 """
 
 from __future__ import annotations
@@ -63,6 +65,24 @@ class PlanTargets(NamedTuple):
     site_forces: Array
 
 
+class _Steady(NamedTuple):
+    """A plan's targets that stay the same through its first step, in the world."""
+
+    plan: Plan
+    frame: PlanarFrame
+    turn: Array
+    acceleration: Array
+    omega_step: Array | None
+    forces: Array
+    site_forces: Array
+
+
+def _read_only(array: Array) -> Array:
+    """``array``, its writes refused (it is handed out on every tick of its plan)."""
+    array.flags.writeable = False
+    return array
+
+
 class PlanReader:
     """Reads a plan's first step as whole-body targets (module docstring).
 
@@ -99,33 +119,53 @@ class PlanReader:
         self._to_feet = np.zeros((feet, len(contact_foot)))
         self._to_feet[list(contact_foot), np.arange(len(contact_foot))] = 1.0
         self.feedforward, self.dt = feedforward, dt
+        self._steady: _Steady | None = None
 
-    def __call__(self, plan: Plan, frame: PlanarFrame, share: float) -> PlanTargets:
-        """The targets ``share`` [-] of the way through ``plan``'s first step, whose library
-        frame is ``frame``."""
-        x = plan.first_step_state(share)
+    def _steady_of(self, plan: Plan, frame: PlanarFrame) -> _Steady:
+        """The targets of ``plan`` in ``frame`` that do not change through its first step,
+        computed on its first tick and kept until the plan or the frame changes."""
+        steady = self._steady
+        if steady is not None and steady.plan is plan and steady.frame is frame:
+            return steady
         turn = frame.rotation()
-        roll, pitch, yaw = (float(x[i]) for i in self._angles)
-        rotation = np.asarray(pin.rpy.rpyToMatrix(roll, pitch, yaw + frame.yaw))
-        qx, qy, qz, qw = pin.Quaternion(rotation).coeffs().tolist()
-        orientation = np.array([qw, qx, qy, qz] if qw >= 0.0 else [-qw, -qx, -qy, -qz])
-        acceleration = angular_acceleration = np.zeros(3)
+        acceleration, omega_step = np.zeros(3), None
         if self.feedforward:
             first, second = plan.states[0], plan.states[1]
             scale = self.feedforward
             velocity_step = scale * (second[self._velocity] - first[self._velocity]) / self.dt
             omega_step = scale * (second[self._omega] - first[self._omega]) / self.dt
             acceleration = turn.dot(velocity_step)
-            angular_acceleration = rotation.dot(omega_step)
         site_forces = plan.first_input[self._force_index].dot(turn.T)
+        forces = self._to_feet.dot(site_forces)
+        self._steady = steady = _Steady(
+            plan,
+            frame,
+            _read_only(turn),
+            _read_only(acceleration),
+            omega_step,
+            _read_only(forces),
+            _read_only(site_forces),
+        )
+        return steady
+
+    def __call__(self, plan: Plan, frame: PlanarFrame, share: float) -> PlanTargets:
+        """The targets ``share`` [-] of the way through ``plan``'s first step, whose library
+        frame is ``frame``."""
+        steady = self._steady_of(plan, frame)
+        x = plan.first_step_state(share)
+        roll, pitch, yaw = (float(x[i]) for i in self._angles)
+        rotation = np.asarray(pin.rpy.rpyToMatrix(roll, pitch, yaw + frame.yaw))
+        qx, qy, qz, qw = pin.Quaternion(rotation).coeffs().tolist()
+        orientation = np.array([qw, qx, qy, qz] if qw >= 0.0 else [-qw, -qx, -qy, -qz])
+        omega_step = steady.omega_step
         return PlanTargets(
             position=frame.point_to_world(x[self._com]),
-            velocity=turn.dot(x[self._velocity]),
+            velocity=steady.turn.dot(x[self._velocity]),
             rotation=rotation,
             orientation=orientation,
             angular_velocity=rotation.dot(x[self._omega]),
-            acceleration=acceleration,
-            angular_acceleration=angular_acceleration,
-            forces=self._to_feet.dot(site_forces),
-            site_forces=site_forces,
+            acceleration=steady.acceleration,
+            angular_acceleration=np.zeros(3) if omega_step is None else rotation.dot(omega_step),
+            forces=steady.forces,
+            site_forces=steady.site_forces,
         )

@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
@@ -128,20 +129,34 @@ class PlanarFrame:
         """:math:`R_z(\\Delta\\psi)`, library axes to world axes."""
         return self._rotation(1.0)
 
+    @cached_property
+    def _to_world(self) -> Array:
+        r""":math:`R_z(\Delta\psi)`, made once per frame (a frame is read several times a
+        tick) and never handed out."""
+        return self._rotation(1.0)
+
+    @cached_property
+    def _to_library(self) -> Array:
+        r""":math:`R_z(-\Delta\psi)`, made once per frame and never handed out."""
+        return self._rotation(-1.0)
+
+    @cached_property
+    def _shift(self) -> Array:
+        r""":math:`\Delta p` [m] as a vector, made once per frame and never handed out."""
+        return np.array([*self.offset, self.height])
+
     def point_to_library(self, p: Array) -> Array:
-        shifted = np.asarray(p, dtype=float) - np.array([*self.offset, self.height])
-        return self._rotation(-1.0).dot(shifted)
+        shifted = np.asarray(p, dtype=float) - self._shift
+        return self._to_library.dot(shifted)
 
     def vector_to_library(self, v: Array) -> Array:
-        return self._rotation(-1.0).dot(np.asarray(v, dtype=float))
+        return self._to_library.dot(np.asarray(v, dtype=float))
 
     def point_to_world(self, p: Array) -> Array:
-        return self._rotation(1.0).dot(np.asarray(p, dtype=float)) + np.array(
-            [*self.offset, self.height]
-        )
+        return self._to_world.dot(np.asarray(p, dtype=float)) + self._shift
 
     def vector_to_world(self, v: Array) -> Array:
-        return self._rotation(1.0).dot(np.asarray(v, dtype=float))
+        return self._to_world.dot(np.asarray(v, dtype=float))
 
 
 class _AngleRate:
@@ -201,6 +216,7 @@ class StateMap:
         self._ground_time = 0.0
         self.ground_rate = 0.0  # [m/s] the followed ground's rise rate
         self._stance: list[int] = []  # the most feet each platform's estimate was taken from
+        self._board_keys: dict[str, tuple[str, int, str]] = {}  # key: (key, platform, field)
         self._fill = [self._filler(name) for name in self.names]
 
     def _filler(self, name: str) -> tuple[str, int | str]:
@@ -218,7 +234,10 @@ class StateMap:
             return ("joint", name[2:])
         if name in self.board_states:
             platform, quantity = self.board_states[name]
-            return ("board", f"{platform}:{quantity}")
+            key = f"{platform}:{quantity}"
+            index, field = key.split(":", 1)  # parsed once, not on each tick
+            self._board_keys[key] = (key, int(index), field)
+            return ("board", key)
         raise ConfigError(f"MPC state map: cannot estimate state '{name}'")
 
     def reset(self) -> None:
@@ -232,12 +251,16 @@ class StateMap:
         self._heading_time = 0.0
 
     def _board_value(
-        self, key: str, boards: tuple[BoardEstimate, ...], time: float, origins: dict[int, Array]
+        self,
+        key: tuple[str, int, str],
+        boards: tuple[BoardEstimate, ...],
+        time: float,
+        origins: dict[int, Array],
     ) -> float:
-        """One board state of ``key`` (``platform:quantity``); ``origins`` holds each
-        platform's position in the library frame once found (one per :meth:`state`)."""
-        index, field = key.split(":", 1)
-        k = int(index)
+        """One board state of ``key`` (``platform:quantity``, the platform and the quantity);
+        ``origins`` holds each platform's position in the library frame once found (one per
+        :meth:`state`)."""
+        name, k, field = key
         if k >= len(boards):
             raise ConfigError(f"MPC state map: no estimate of platform {k}")
         board = boards[k]
@@ -257,11 +280,18 @@ class StateMap:
             return board.roll
         if field == "speed":
             return forward_speed(board)
-        angle = {"pitch_rate": board.pitch, "roll_rate": board.roll, "yaw_rate": board.yaw}
-        if field in angle:
-            rate = self._rates.setdefault(key, _AngleRate(RATE_FILTER_HZ))
-            return rate(time, angle[field])
-        raise ConfigError(f"MPC state map: unknown board state '{field}'")
+        if field == "pitch_rate":
+            angle = board.pitch
+        elif field == "roll_rate":
+            angle = board.roll
+        elif field == "yaw_rate":
+            angle = board.yaw
+        else:
+            raise ConfigError(f"MPC state map: unknown board state '{field}'")
+        rate = self._rates.get(name)
+        if rate is None:
+            rate = self._rates[name] = _AngleRate(RATE_FILTER_HZ)
+        return rate(time, angle)
 
     def state(self, estimate: EstimatedState) -> Array:
         """:math:`x_0` in the library frame, the pair's layout."""
@@ -288,7 +318,8 @@ class StateMap:
             elif kind == "joint":
                 x[i] = estimate.joint_position[str(key)]
             else:
-                x[i] = self._board_value(str(key), estimate.boards, estimate.time, origins)
+                parsed = self._board_keys[str(key)]
+                x[i] = self._board_value(parsed, estimate.boards, estimate.time, origins)
         return x
 
     def com(self, estimate: EstimatedState) -> Array:

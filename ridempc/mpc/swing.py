@@ -76,6 +76,9 @@ class ReferenceFeet:
             if name.startswith("q_")
         ]
         self._state_of_q = {index: i for i, index in self._joints}
+        # the same pairs as two index arrays: the joints written in one assignment
+        self._joint_rows = np.array([i for i, _ in self._joints], dtype=np.int64)
+        self._joint_q = np.array([index for _, index in self._joints], dtype=np.int64)
         self._rows: dict[bytes, NDArray[np.int64]] = {}  # state rows per order of the motors
         self._com = [names[f"com_{a}"] for a in "xyz"]
         self._angles = [names[f"{base_prefix}{a}"] for a in ("roll", "pitch", "yaw")]
@@ -99,14 +102,13 @@ class ReferenceFeet:
     def points(self, state: Array) -> Array:
         """:math:`p_f` of every foot in the library frame [m], shape (feet, 3)."""
         q = self._q
-        for i, index in self._joints:
-            q[index] = state[i]
+        q[self._joint_q] = state[self._joint_rows]
         roll, pitch, yaw = (float(state[i]) for i in self._angles)
         rotation = euler_zyx_matrix(roll, pitch, yaw)
         q[:3] = 0.0
         q[3:7] = pin.Quaternion(rotation).coeffs()  # x, y, z, w
-        com = pin.centerOfMass(self.model.model, self._data, q)
-        return self.model.foot_points(q) - com + state[self._com]
+        com = pin.centerOfMass(self.model.model, self._data, q)  # the joints placed at q
+        return self.model.placed_foot_points(self._data) - com + state[self._com]
 
     def targets(
         self, states: Array, frame: PlanarFrame, board: BoardEstimate | None

@@ -255,6 +255,16 @@ class WholeBodyModel:
         sites = np.array([data.oMf[f].translation for f in self.site_frames])
         return np.asarray(self._foot_sum.dot(sites) / self._foot_count)
 
+    def placed_foot_points(self, data: pin.Data) -> Array:
+        """:meth:`foot_points` from ``data`` whose joints are already placed at the
+        configuration (``forwardKinematics``, or ``centerOfMass`` with it): the same
+        points without a second pass over the joints [m], shape (feet, 3)."""
+        model = self.model
+        sites = np.array(
+            [pin.updateFramePlacement(model, data, f).translation for f in self.site_frames]
+        )
+        return np.asarray(self._foot_sum.dot(sites) / self._foot_count)
+
     def passive_torque(self, q: Array, v: Array) -> Array:
         """:math:`\\tau_p = -K (q - q_{ref}) - D v` [N m] (springs and joint damping)."""
         tau = -self._damping * v
