@@ -22,6 +22,7 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
+from ridempc.mpc.bounce import BounceRise
 from ridempc.mpc.divergence import DivergentDeviation
 from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION
@@ -95,18 +96,23 @@ def diverging(check: HandoverCheck) -> str | None:
 
 class DropWatch:
     """The platforms falling away under every foot at once (a step down), from each tick's
-    loads (:class:`~ridempc.mpc.drop.DropDetector`): a tick observer and a trigger."""
+    loads (:class:`~ridempc.mpc.drop.DropDetector`): a tick observer and a trigger. The
+    rider counts as rising on a bounce's way down until she sinks faster than she rose
+    (:class:`~ridempc.mpc.bounce.BounceRise`): its unloaded top is no drop."""
 
     def __init__(self, detector: DropDetector) -> None:
         self.detector, self.dropping = detector, False
+        self.bounce = BounceRise()
 
     def reset(self) -> None:
         """Start over (a new ride)."""
         self.detector.reset()
+        self.bounce.reset()
 
     def observe(self, tick: ControlTick) -> None:
         estimate = tick.estimate
-        rising, feet = float(estimate.base_velocity[2]), estimate.foot_velocity[:, 2]
+        rising = self.bounce.update(float(estimate.base_velocity[2]))
+        feet = estimate.foot_velocity[:, 2]
         self.dropping = self.detector.update(tick.loads, rising, float(feet.max()))
 
     def __call__(self, check: HandoverCheck) -> str | None:
