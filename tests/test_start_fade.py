@@ -7,8 +7,9 @@ import math
 
 import pytest
 
+from ridempc.mpc.divergence import GRAVITY
 from ridempc.mpc.handover import POSTURE_FADE_S, Fallback, Handover
-from ridempc.mpc.start_fade import GRAVITY, StartFade, start_window
+from ridempc.mpc.start_fade import StartFade, start_window
 
 
 def _handover() -> Handover:

@@ -27,11 +27,10 @@ from __future__ import annotations
 
 import math
 
+from ridempc.mpc.divergence import GRAVITY
 from ridempc.mpc.handover import Handover
 
-__all__ = ["GRAVITY", "StartFade", "start_window"]
-
-GRAVITY: float = 9.81  # [m/s^2]
+__all__ = ["StartFade", "start_window"]
 
 
 def start_window(com_height: float) -> float:
