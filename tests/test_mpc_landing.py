@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from types import SimpleNamespace
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -11,6 +13,11 @@ from ridempc.estimation.state import EstimatedState
 from ridempc.mpc.drop import SINK_SPEED
 from ridempc.mpc.flight import LAND_TICKS, DropFlight
 from ridempc.mpc.landing import LANDING_S, LandingLoads
+from ridempc.mpc.plan_book import PlanBook
+from ridempc.mpc.stages.feet_targets import FootTargets
+from ridempc.mpc.stages.wbc_targets import TargetsFromPlan
+from ridempc.mpc.state_map import PlanarFrame
+from ridempc.trajopt.schedule import Contact
 from tests.helpers import board_estimate
 
 DT = 0.002  # [s] the whole-body QP's tick
@@ -66,6 +73,38 @@ def test_a_landed_foot_loads_its_sites_evenly() -> None:
     np.testing.assert_allclose(out[0] + out[1], HEELS[0] + HEELS[1])
     np.testing.assert_allclose(out[2] + out[3], HEELS[2] + HEELS[3])
     assert loads(HEELS, 0.1 + LANDING_S + DT) is HEELS
+
+
+def test_the_whole_body_targets_carry_the_landed_split() -> None:
+    """The targets' site forces are the landing's (each foot's mean) within its window."""
+    rates = ("velocity", "acceleration", "angular_velocity", "angular_acceleration")
+    wanted = SimpleNamespace(
+        site_forces=HEELS,
+        forces=np.zeros((2, 3)),
+        position=np.array([0.0, 0.0, 0.9]),
+        orientation=np.array([1.0, 0.0, 0.0, 0.0]),
+        **{name: np.zeros(3) for name in rates},
+    )
+    standing = FootTargets(np.ones(2), np.zeros((2, 3)), np.zeros((2, 3)), None)
+    book = PlanBook(None)
+    book.plan, book.time, book.frame = cast(Any, object()), 0.1, PlanarFrame(0.0)
+    flight = _landed_flight(0.1)
+    targets = TargetsFromPlan(
+        cast(Any, lambda plan, frame, age: wanted),
+        cast(Any, lambda support, t_ref, estimate, frame: standing),
+        flight,
+        None,
+        True,
+        LandingLoads(flight, CONTACT_FOOT),
+    )
+    estimate = cast(Any, SimpleNamespace(boards=()))
+    support = (Contact.BOARD, Contact.BOARD)
+    out = targets(book, support, 0.0, estimate, 0.15)
+    assert out.site_forces is not None
+    np.testing.assert_allclose(out.site_forces[1], 0.5 * (HEELS[0] + HEELS[1]))
+    later = targets(book, support, 0.0, estimate, 0.1 + 2.0 * LANDING_S)
+    assert later.site_forces is not None
+    np.testing.assert_array_equal(later.site_forces, HEELS)
 
 
 def test_a_window_must_be_positive() -> None:
