@@ -68,6 +68,8 @@ class DropFlight:
 
     Attributes:
         starts: When each flight of the ride began [s] (``summary.json``'s ``flights_s``).
+        landed: When the last flight landed [s] (None: none yet), for
+            :mod:`~ridempc.mpc.landing`.
 
     Args:
         watch: The drop's watch, observed before this stage each tick (None: ``update``
