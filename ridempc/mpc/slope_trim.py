@@ -17,9 +17,7 @@ estimated under the platforms (:mod:`ridempc.mpc.slope`) has been steeper than `
 
 so that the trim :math:`\\delta` [m/s] moves at :math:`(v_{cmd} - v)/T` on a steady slope and
 goes with the slope where it ends (within the slope estimate's 0.3 s); on level ground it is
-zero. A speed error over ``BAND`` (the crest's dip, where the slope's pull comes before its
-estimate) is integrated as ``BAND``, so that the trim moves at most at ``BAND``/:math:`T`
-and starts giving the speed back during the dip, not after it; none is integrated while the
+zero. A speed error over ``BAND`` is a transient and is not integrated, nor one while the
 backup rides. The reference's speeds (the rider's and each platform's) are raised by
 :math:`\\delta` and its positions moved on by :math:`\\delta\\,t` over the horizon along the
 platforms' heading (:class:`SlopeTrim`, a problem shaper).
@@ -60,8 +58,8 @@ TIME_CONSTANT: float = 1.0
 # trimmed reference stays within a step of the library's; twice the steady error measured down
 # 13 deg (0.15-0.17 m/s).
 LIMIT: float = 0.3
-# [m/s] the largest speed error integrated (a larger one, a crest's run-off, counts as this):
-# the manoeuvres' own band for a new speed, so the trim moves at most at 0.25 m/s^2
+# [m/s] a speed error larger than this is a transient (a crest's run-off, a push), which
+# the plan rides out, not the slope's steady offset: the manoeuvres' own band for a new speed
 BAND: float = RETARGET_BAND
 
 
@@ -117,10 +115,8 @@ class SlopeSpeedTrim:
         if self._sloped < HOLD or wanted < MOVING:
             self.value = 0.0  # level ground (or rest): the library's ride
             return self.value
-        # a larger error (a crest's dip) is integrated at the band's: the trim starts
-        # giving back the slope's speed while the dip lasts, at a rate the rider follows
-        error = min(max(wanted - speed, -BAND), BAND)
-        if riding:
+        error = wanted - speed
+        if riding and abs(error) < BAND:  # a larger error is a transient, not the offset
             bound = self.limit / slope
             rate = error / (self.time_constant * slope)
             self.per_slope = min(max(self.per_slope + rate * dt, -bound), bound)
