@@ -219,6 +219,11 @@ class TakeoverStage(_Frozen):
 class FlightStage(_Frozen):
     extend_speed: Speed = Field(description="How fast the feet reach down after the shoes [m/s].")
     max_extension: Positive = Field(le=0.5, description="How far they reach at most [m].")
+    landing: Positive | None = Field(
+        default=None,
+        le=1.0,
+        description="How long each foot's load stays centred on its shoe after a landing [s].",
+    )
 
 
 class ImpulseStage(_Frozen):

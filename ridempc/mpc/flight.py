@@ -68,6 +68,8 @@ class DropFlight:
 
     Attributes:
         starts: When each flight of the ride began [s] (``summary.json``'s ``flights_s``).
+        landed: When the last flight landed [s] (None: none yet), for
+            :mod:`~ridempc.mpc.landing`.
 
     Args:
         watch: The drop's watch, observed before this stage each tick (None: ``update``
@@ -95,6 +97,7 @@ class DropFlight:
         self._sank = False  # whether a foot has sunk faster than SINK_SPEED in this flight
         self._stopped = 0
         self.starts: list[float] = []  # [s] when each flight of the ride began
+        self.landed: float | None = None  # [s] when the last flight landed
 
     @property
     def flying(self) -> bool:
@@ -106,6 +109,7 @@ class DropFlight:
         self._sank = False
         self._stopped = 0
         self.starts = []
+        self.landed = None
 
     def update(self, dropped: bool, estimate: EstimatedState) -> bool:
         """Take this tick's drop detection and estimate; whether the drop is in the air.
@@ -132,6 +136,7 @@ class DropFlight:
         self._stopped = self._stopped + 1 if landed else 0
         if self._stopped >= LAND_TICKS:
             self._start = None
+            self.landed = estimate.time
         return self.flying
 
     def observe(self, tick: ControlTick) -> None:

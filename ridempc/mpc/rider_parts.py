@@ -20,6 +20,7 @@ from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.flight import DropFlight
 from ridempc.mpc.force_filter import ForceFilter
 from ridempc.mpc.handover import RETURN_DWELL_S, STANDBY_DIVIDER, Handover, share_estimator
+from ridempc.mpc.landing import LandingLoads
 from ridempc.mpc.lean import Crouch, LeanSteering
 from ridempc.mpc.manoeuvre import REPUSH, Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import check_library_names, load_mpc_pair
@@ -240,8 +241,11 @@ class RiderParts(Controller):
             if stages.flight is not None
             else None
         )
+        landing = None  # the landing ridden flat-footed (``[stages.flight] landing``)
+        if self.flight is not None and stages.flight is not None and stages.flight.landing:
+            landing = LandingLoads(self.flight, self._contact_foot, stages.flight.landing)
         self.targets = TargetsFromPlan(  # the whole-body QP's targets from the plan in force
-            self._read_plan, self.feet_targets, self.flight, self.shoes, self._sites_match
+            self._read_plan, self.feet_targets, self.flight, self.shoes, self._sites_match, landing
         )
         self._com_height = 1.0  # [m] the centre of mass over the feet, at the last MPC tick
         law = backup if backup is not None else _backup(robot, board)

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.flight import DropFlight
+from ridempc.mpc.landing import LandingLoads
 from ridempc.mpc.plan_book import PlanBook
 from ridempc.mpc.plan_targets import PlanReader
 from ridempc.mpc.shoe_observer import ShoeObserver
@@ -36,6 +37,7 @@ class TargetsFromPlan:
         shoes: The shoes' observer (None: not the Hovershoes).
         sites_match: Whether the library's contacts are the WBC's sites (the plan's
             forces are then applied at each site: the centre of pressure along a foot).
+        landing: Each foot's load centred after a flight's landing (None: no ``landing``).
     """
 
     def __init__(
@@ -45,12 +47,14 @@ class TargetsFromPlan:
         flight: DropFlight | None,
         shoes: ShoeObserver | None,
         sites_match: bool,
+        landing: LandingLoads | None = None,
     ) -> None:
         self.read_plan = read_plan
         self.feet_targets = feet_targets
         self.flight = flight
         self.shoes = shoes
         self.sites_match = sites_match
+        self.landing = landing
 
     def __call__(
         self,
@@ -70,6 +74,9 @@ class TargetsFromPlan:
         if self.flight is not None and self.flight.flying:  # no foot stands: mpc/flight.py
             feet, swing_acceleration = self.flight.feet(feet, estimate)
         shoes = self.shoes
+        site_forces = wanted.site_forces if self.sites_match else None
+        if site_forces is not None and self.landing is not None:  # mpc/landing.py
+            site_forces = self.landing(site_forces, now)
         return WbcTargets(
             position=wanted.position,
             orientation=wanted.orientation,
@@ -79,7 +86,7 @@ class TargetsFromPlan:
             acceleration=wanted.acceleration,
             angular_velocity=wanted.angular_velocity,
             angular_acceleration=wanted.angular_acceleration,
-            site_forces=wanted.site_forces if self.sites_match else None,
+            site_forces=site_forces,
             swing_position=feet.swing,
             swing_velocity=feet.swing_velocity,
             swing_acceleration=swing_acceleration,
