@@ -30,9 +30,10 @@ from ridempc.scenarios.scenario import Disturbance, Scenario
 GRAVITY = 9.81  # [m/s^2]
 LIBRARY_PUSH = 0.2  # [m/s] the library's push on the skateboard: 1 N/kg for 0.2 s, sideways
 OVER_READ = 1.15  # [-] the observer reads the library's push as 0.23 m/s (mass and forces modelled)
-# [-] the observer reads the library's sideways push 1.11-1.17x on the two robots (CyberDog2
-# 0.223, Go1 0.233 m/s: its mass and forces modelled, not measured), so a quarter over at most
-MOST_OVER_READ = 1.25
+# [-] the observer reads the library's sideways push 1.11-1.21x on the two robots (seed 0:
+# CyberDog2 0.223, Go1 0.242 m/s; its mass and forces modelled, not measured), and a tenth
+# more for other seeds' noise
+MOST_OVER_READ = 1.35
 ROUNDING = 0.02  # [m/s] the pair files give the bands to two figures
 
 
@@ -83,7 +84,7 @@ def test_the_bands_follow_the_stance_and_the_decks_roll(robot: str) -> None:
     library = resolve_scenario("push", "skateboard").disturbances
     across_push = max(abs(d.force[1]) * d.duration for d in library if d.body == "base")
     assert stage.band == pytest.approx(along, abs=ROUNDING)
-    # the band never below the library's push as the observer reads it, at most a quarter over
+    # the band never below the library's push as the observer reads it
     assert stage.sideways == pytest.approx(max(across, across_push * MOST_OVER_READ), abs=ROUNDING)
     assert stage.sideways > across_push * OVER_READ  # the library's push rides on the MPC
 
