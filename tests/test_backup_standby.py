@@ -1,6 +1,8 @@
 """A backup law's standby tick (``Controller.standby``, ``ridempc.mpc.handover``): its state
 advanced without its command, so that its next update's command is the one a law updated in
-full at every tick gives, to the bit. A short ride (no timing)."""
+full at every tick gives, to the bit. A short ride (no timing). The roll error's integral is
+the one state a standby holds rather than advances (another law rolls the deck then; tested
+in ``tests/test_quadruped_skateboard.py``), so here its gain is zero."""
 
 from __future__ import annotations
 
@@ -8,6 +10,11 @@ import numpy as np
 import pytest
 
 from ridempc.baselines.quadruped_skateboard import QuadrupedSkateboardPD
+from ridempc.baselines.quadruped_skateboard_gains import (
+    QuadrupedSkateboardGains,
+    gains_file,
+    load_quadruped_skateboard_gains,
+)
 from ridempc.boards import load_board
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -18,13 +25,20 @@ from ridempc.sim.simulation import Simulation
 EVERY = 7  # [ticks] the twin's full updates; standby on the ticks between
 
 
+def _without_integral(robot: str, board: str) -> QuadrupedSkateboardGains:
+    """The pair's PD gains with the roll error's integral switched off."""
+    gains = load_quadruped_skateboard_gains(gains_file(robot, board))
+    return gains.model_copy(update={"roll": gains.roll.model_copy(update={"ki": 0.0})})
+
+
 class _WithTwin(QuadrupedSkateboardPD):
     """The PD riding, and a twin fed the same packets: in standby, and updated in full every
     :data:`EVERY` ticks, its commands then kept beside the rider's."""
 
     def __init__(self, robot, board: str) -> None:
-        super().__init__(robot, board)
-        self.twin = QuadrupedSkateboardPD(robot, board)
+        gains = _without_integral(robot.name, board)
+        super().__init__(robot, board, gains)
+        self.twin = QuadrupedSkateboardPD(robot, board, gains)
         self.ticks = 0
         self.pairs: list = []
 

@@ -216,3 +216,30 @@ def test_a_backup_in_standby_keeps_the_rides_time(dog) -> None:
     riding, standby = controller._shift[0], controller.twin._shift[0]
     assert abs(riding) > 0.005  # [m] the wave has moved the centre of mass
     assert standby == pytest.approx(riding, rel=0.25)
+
+
+class _InStandby(QuadrupedSkateboardPD):
+    """The PD riding, and a twin fed the same packets through :meth:`standby` each tick,
+    as a backup is while the MPC rides."""
+
+    def __init__(self, robot, board: str) -> None:
+        super().__init__(robot, board)
+        self.twin = QuadrupedSkateboardPD(robot, board)
+
+    def update(self, sensors, command):
+        self.twin.standby(sensors, command)
+        return super().update(sensors, command)
+
+
+def test_a_backup_in_standby_holds_its_roll_integral(dog) -> None:
+    """In standby the roll error is another law's to remove: the twin's integral stays
+    where it was (zero from its reset) while the riding PD's integrates the wave's error,
+    and the twin's filtered feedback still follows the deck."""
+    scenario = resolve_scenario("roll-tracking", "skateboard").with_duration(1.5)
+    scene = build_scene(dog, DEFAULT_PHYSICS_HZ, board=load_board("skateboard"))
+    controller = _InStandby(dog, "skateboard")
+    result = Simulation(scene, controller, scenario).run()
+    assert result.status == "ok", result.fall_reason or result.error
+    assert abs(controller._roll_integral) > 1e-5  # [m] the riding PD has integrated
+    assert controller.twin._roll_integral == 0.0
+    assert controller.twin._feedback[0] != 0.0

@@ -364,10 +364,22 @@ class QuadrupedSkateboardPD(Controller):
         return ticks / self.rate_hz
 
     def lateral_shift(
-        self, sensors: SensorPacket, command: Command, state: StanceState
+        self,
+        sensors: SensorPacket,
+        command: Command,
+        state: StanceState,
+        integrate: bool = True,
     ) -> tuple[float, float]:
         """The centre of mass's shift to the right :math:`u` [m] and its rate [m/s]; zero on
-        flat ground."""
+        flat ground.
+
+        Args:
+            sensors: This tick's packet.
+            command: The ride's command.
+            state: The stance observed this tick.
+            integrate: Whether the roll error's integral advances; held (not integrated)
+                while this law is in standby (:meth:`standby`).
+        """
         model = self.roll_model
         if model is None:
             return 0.0, 0.0
@@ -395,9 +407,10 @@ class QuadrupedSkateboardPD(Controller):
         self._roll_rate += alpha * (state.deck.roll_rate - self._roll_rate)
         error = reference - state.deck.roll
         error_rate = reference_rate - self._roll_rate
-        self._roll_integral = _clip(
-            self._roll_integral + gains.ki * error * dt, gains.integral_limit
-        )
+        if integrate:
+            self._roll_integral = _clip(
+                self._roll_integral + gains.ki * error * dt, gains.integral_limit
+            )
         raw = gains.kp * error + gains.kd * error_rate + self._roll_integral
         w = gains.feedback_bandwidth
         feedback, feedback_rate = self._feedback
@@ -428,19 +441,27 @@ class QuadrupedSkateboardPD(Controller):
 
     def standby(self, sensors: SensorPacket, command: Command) -> None:
         """The estimator and the roll's filters (:meth:`lateral_shift`) advanced, no
-        command (the legs' inverse kinematics and torques left out)."""
-        self._advance(sensors, command)
+        command (the legs' inverse kinematics and torques left out).
+
+        The roll error's integral is held, not advanced (conditional integration, the
+        standard anti-windup): in standby another law rolls the deck, so the error is not
+        this law's to remove, and integrated over a ride it winds the integral towards its
+        limit (a third of the feet's half-spacing), which a law handed the ride mid-push
+        then shifts the centre of mass by on top of the push.
+        """
+        self._advance(sensors, command, integrate=False)
 
     def _advance(
-        self, sensors: SensorPacket, command: Command
+        self, sensors: SensorPacket, command: Command, integrate: bool = True
     ) -> tuple[StanceState, tuple[float, float]]:
-        """What a tick carries to the next: the estimator, the stance, the shift's filters."""
+        """What a tick carries to the next: the estimator, the stance, the shift's filters
+        (the roll error's integral only where ``integrate``)."""
         if not self._ready:
             self.reset(sensors)
         else:
             self.estimator.update(sensors)
         state = self.observe(sensors)
-        return state, self.lateral_shift(sensors, command, state)
+        return state, self.lateral_shift(sensors, command, state, integrate)
 
     def update(self, sensors: SensorPacket, command: Command) -> MotorCommand:
         state, (shift, shift_rate) = self._advance(sensors, command)
