@@ -37,9 +37,7 @@ def _start(*args: str, script: str | None = None) -> subprocess.Popen[str]:
         **os.environ,
         "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
     }
-    command = (
-        [sys.executable, "-c", script] if script else [sys.executable, "-m", "ridempc", *args]
-    )
+    command = [sys.executable, "-c", script] if script else [sys.executable, "-m", "ridempc", *args]
     return subprocess.Popen(
         command, env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )

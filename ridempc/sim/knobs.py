@@ -50,6 +50,7 @@ __all__ = ["KNOBS", "PAYLOAD_OFFSET_MAX", "SCALE_MAX", "Action", "Knob"]
 Array = NDArray[np.float64]
 Action = Callable[[mujoco.MjData], None]
 
+
 @dataclass(frozen=True)
 class Knob:
     """One physical parameter a scenario can change.

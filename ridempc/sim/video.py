@@ -23,8 +23,8 @@ def require_video_writer() -> None:
     if importlib.util.find_spec("imageio_ffmpeg") is None:
         raise ConfigError(
             "--video needs the 'video' extra (the ffmpeg binary, about 170 MB), which is not "
-            "installed: pip install \"ridempc[video]\" "
-            "(from a checkout: pip install -e \".[video]\")"
+            'installed: pip install "ridempc[video]" '
+            '(from a checkout: pip install -e ".[video]")'
         )
 
 
