@@ -65,10 +65,10 @@ class QpKind:
 # in its workspace 1.13 / 1.32, HPIPM from a cold start 2.09 / 3.20, proxqp 4.50 / 4.90,
 # DAQP (dense) 14.3 / 18.9. The whole-body QP (dense, 56 variables): DAQP 0.04 / 0.08 to
 # the same optimum (objective within 2e-15), OSQP warm-started 0.21 / 0.28, proxqp
-# 0.23 / 0.39. docs/tuning.md, "Speed (issue 39): solvers and the MPC tick". Session 10, the
-# four pairs' recorded MPC problems (CPU clock): OSQP warm-started still the fastest, the
-# next HPIPM or PIQP from a cold start at 1.9-2.3x its median ("The MPC's QP rows held in one
-# OSQP class ...").
+# 0.23 / 0.39. docs/tuning.md, "Speed (issue 39): solvers and the MPC tick". On the four
+# pairs' recorded MPC problems (CPU clock) OSQP warm-started is the fastest, the next (HPIPM
+# or PIQP from a cold start) at 1.9-2.3x its median (docs/tuning.md, "The MPC's QP rows held
+# in one OSQP class ...").
 QP_KINDS: MappingProxyType[str, QpKind] = MappingProxyType(
     {
         "mpc": QpKind(
