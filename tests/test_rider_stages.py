@@ -51,10 +51,13 @@ class _Pushed:
         return "a push"
 
 
-def _reason(check: HandoverCheck, dropping: bool = False, pushed: bool = False) -> str | None:
+def _reason(
+    check: HandoverCheck, dropping: bool = False, pushed: bool = False, alone: bool = False
+) -> str | None:
     drop = DropWatch(DropDetector())
     drop.dropping = dropping
-    for trigger in handover_triggers(drop, cast(Any, _Pushed()) if pushed else None):
+    push = cast(Any, _Pushed()) if pushed else None
+    for trigger in handover_triggers(drop, push, failures_only=alone):
         reason = trigger(check)
         if reason is not None:
             return reason
@@ -70,6 +73,14 @@ def test_the_triggers_give_the_first_reason_in_their_order() -> None:
     assert _reason(_check(deviation=far), pushed=True) == "a push"
     assert "from the reference" in str(_reason(_check(deviation=far)))
     assert _reason(_check(deviation=far, stroke=True)) is None  # a re-push's stroke rides out
+
+
+def test_the_mpc_alone_hands_over_only_its_own_failures() -> None:
+    far = 2.0 * HANDOVER_DEVIATION
+    assert _reason(_check(deviation=far), pushed=True, alone=True) is None
+    assert "MPC plan failed" in str(_reason(_check(plan=_plan(True)), alone=True))
+    assert "a drop" in str(_reason(_check(), dropping=True, alone=True))
+    assert "slack 0.1" in str(_reason(_check(slack=0.1), alone=True))
 
 
 def test_a_divergence_hands_over_only_while_on_probation() -> None:

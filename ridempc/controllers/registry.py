@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ridempc.controllers.base import Controller
-from ridempc.controllers.mpc import make_mpc_rider
+from ridempc.controllers.mpc import make_mpc_alone, make_mpc_rider
 from ridempc.controllers.pd import make_pd_baseline
 from ridempc.controllers.stand import StandController
 from ridempc.errors import ConfigError, UnknownNameError
@@ -21,6 +21,7 @@ CONTROLLERS: dict[str, Callable[[Robot, str], Controller]] = {
     "stand": StandController,
     "pd": make_pd_baseline,
     "mpc": make_mpc_rider,
+    "mpc-alone": make_mpc_alone,
 }
 
 

@@ -106,6 +106,9 @@ class MpcRider(RiderReports):
         backup: The law the ride is handed to when the MPC fails
             (:mod:`~ridempc.mpc.handover`); None: the registry's :data:`BACKUP_LAW` for
             the pair.
+        hands_over_deviations: Whether a push or a deviation from the reference hands the
+            ride to the backup law; False: only the MPC's own failures (a failed plan, a
+            drop, a whole-body QP on slack), the ``mpc-alone`` ablation.
 
     Raises:
         UnknownNameError: No MPC for this robot-board pair.

@@ -93,9 +93,14 @@ class RiderParts(Controller):
         wbc_solver: str | None = None,
         plan_latency: int | None = None,
         backup: Controller | None = None,
+        hands_over_deviations: bool = True,
     ) -> None:
         super().__init__(robot, board)
         from ridempc.boards import load_board
+
+        # Whether a push or a deviation from the reference hands the ride to the backup law
+        # (False: only the MPC's own failures, the ``mpc-alone`` ablation).
+        self.hands_over_deviations = hands_over_deviations
 
         self.pair = load_mpc_pair(robot.name, board)
         stages = self.pair.description.stages  # the pair file's per-pair mechanisms
@@ -324,7 +329,9 @@ class RiderParts(Controller):
         self.wbc_observers: tuple[TickObserver, ...] = present(shoes, self.push_watch)
         self.drifts: tuple[DriftSource, ...] = self._drift_sources()
         self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
-        self.triggers = handover_triggers(self.drop_watch, self.push_watch, self.flight)
+        self.triggers = handover_triggers(
+            self.drop_watch, self.push_watch, self.flight, not self.hands_over_deviations
+        )
 
     def _drift_sources(self) -> tuple[DriftSource, ...]:
         """The disturbance observers whose drifts the MPC's rates carry, in the order they

@@ -161,9 +161,16 @@ class PushWatch:
 
 
 def handover_triggers(
-    drop: DropWatch | None, push: PushWatch | None, flight: HandoverTrigger | None = None
+    drop: DropWatch | None,
+    push: PushWatch | None,
+    flight: HandoverTrigger | None = None,
+    failures_only: bool = False,
 ) -> tuple[HandoverTrigger, ...]:
     """The triggers in the order asked (the first reason is the one recorded), with the
     pair's watches where it has them; a drop's flight (:mod:`~ridempc.mpc.flight`) in the
-    drop's place, which it rides."""
+    drop's place, which it rides. ``failures_only``: only what leaves the MPC without a
+    command it can trust (1-3: a failed plan, a drop, a whole-body QP on slack), so a ride
+    measures the MPC itself (the ``mpc-alone`` ablation), no push or deviation handed over."""
+    if failures_only:
+        return present(plan_failed, flight or drop, needs_slack)
     return present(plan_failed, flight or drop, needs_slack, push, deviated, diverging)
