@@ -458,6 +458,17 @@ def test_lapack_helpers_give_numpys_results() -> None:
         lapack.solve(np.zeros((3, 3)), np.ones(3))
 
 
+def test_lapack_pinv_is_numpys_bit_for_bit() -> None:
+    """The quadruped's deck fit (4 x 3, also rank-deficient) and a wide matrix."""
+    rng = np.random.default_rng(6)
+    for shape in ((4, 3), (4, 3), (3, 5)):
+        a = rng.normal(size=shape)
+        assert np.array_equal(lapack.pinv(a), np.linalg.pinv(a))
+    a = rng.normal(size=(4, 3))
+    a[:, 2] = a[:, 1]  # a repeated column: its smallest singular value cut off
+    assert np.array_equal(lapack.pinv(a), np.linalg.pinv(a))
+
+
 def test_joint_values_read_their_array_by_name() -> None:
     values = JointValues({"hip": 0, "knee": 1}, np.array([0.1, -0.2]))
     assert list(values) == ["hip", "knee"] and len(values) == 2

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.estimation.lapack import pinv, solve
+
 __all__ = ["SupportPlane", "fit_support_plane", "vertical_loads"]
 
 Array = NDArray[np.float64]
@@ -63,7 +65,7 @@ def fit_support_plane(points: Array, velocities: Array | None = None) -> Support
         velocities: Their velocities in the same frame [m/s], for the roll rate.
     """
     design = np.column_stack((np.ones(len(points)), points[:, 0], points[:, 1]))
-    pseudo_inverse = np.linalg.pinv(design)
+    pseudo_inverse = pinv(design)
     z0, b, c = pseudo_inverse @ points[:, 2]
     normal = np.array([-b, -c, 1.0]) / math.sqrt(1.0 + b * b + c * c)
     roll = math.atan2(-normal[1], math.hypot(normal[0], normal[2]))
@@ -90,5 +92,5 @@ def vertical_loads(feet_xy: Array, com_xy: Array, weight: float, minimum: float)
     rel = feet_xy - com_xy
     constraints = np.vstack((np.ones(len(rel)), rel[:, 0], rel[:, 1]))
     wanted = np.array([weight, 0.0, 0.0])
-    loads = constraints.T @ np.linalg.solve(constraints @ constraints.T, wanted)
+    loads = constraints.T @ solve(constraints @ constraints.T, wanted)
     return np.maximum(loads, minimum)
