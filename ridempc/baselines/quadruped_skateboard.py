@@ -291,7 +291,7 @@ class QuadrupedSkateboardPD(Controller):
         rotation_wb = quaternion_to_matrix(sensors.imu.quaternion)
         yaw = math.atan2(rotation_wb[1, 0], rotation_wb[0, 0])
         rotation_lb = rotation_z(-yaw) @ rotation_wb  # level frame, yawed with the trunk
-        wx, wy, wz = (float(v) for v in sensors.imu.angular_velocity)
+        wx, wy, wz = np.asarray(sensors.imu.angular_velocity, dtype=float).tolist()
         omega_cross = np.array([[0.0, -wz, wy], [wz, 0.0, -wx], [-wy, wx, 0.0]])
         feet_b = np.empty((4, 3))
         velocities_b = np.empty((4, 3))

@@ -64,7 +64,8 @@ def fit_support_plane(points: Array, velocities: Array | None = None) -> Support
         points: Foot centres in a level frame [m].
         velocities: Their velocities in the same frame [m/s], for the roll rate.
     """
-    design = np.column_stack((np.ones(len(points)), points[:, 0], points[:, 1]))
+    design = np.ones((len(points), 3))  # rows (1, x_i, y_i)
+    design[:, 1:] = points[:, :2]
     pseudo_inverse = pinv(design)
     z0, b, c = pseudo_inverse @ points[:, 2]
     normal = np.array([-b, -c, 1.0]) / math.sqrt(1.0 + b * b + c * c)
