@@ -224,6 +224,11 @@ class FlightStage(_Frozen):
         le=1.0,
         description="How long each foot's load stays centred on its shoe after a landing [s].",
     )
+    landing_depth: NonNegative = Field(
+        default=0.0,
+        le=0.5,
+        description="The shallowest fall whose landing is ridden flat-footed [m].",
+    )
 
 
 class ImpulseStage(_Frozen):

@@ -26,35 +26,65 @@ CONTACT_FOOT = (0, 0, 1, 1)  # Cassie's toe lines: front and back site of each f
 HEELS = np.array([[1.0, 0.0, 8.0], [-3.0, 2.0, 205.0], [0.5, 0.0, 10.0], [-2.0, -1.0, 164.0]])
 
 
-def _estimate(t: float, feet_vz: float) -> EstimatedState:
+def _estimate(t: float, feet_vz: float, drop: float = 0.0) -> EstimatedState:
+    """Both feet sinking at ``feet_vz`` [m/s], ``drop`` [m] below where they started."""
     velocity = np.zeros((2, 3))
     velocity[:, 2] = feet_vz
     return replace(
         board_estimate(t, ()),
-        base_position=np.array([0.0, 0.0, 1.0]),
+        base_position=np.array([0.0, 0.0, 1.0 - drop]),
         base_velocity=np.array([0.5, 0.0, 0.0]),
-        foot_position=np.array([[0.0, 0.1, 0.0], [0.0, -0.1, 0.0]]),
+        foot_position=np.array([[0.0, 0.1, -drop], [0.0, -0.1, -drop]]),
         foot_velocity=velocity,
     )
 
 
-def _landed_flight(at: float) -> DropFlight:
-    """A flight from a drop at 0 s whose feet sank and stopped, landing at ``at`` [s]."""
-    flight = DropFlight()
-    flight.update(True, _estimate(0.0, 0.0))
-    flight.update(False, _estimate(0.05, -2.0 * SINK_SPEED))
+def _landed_flight(at: float, depth: float = 0.0, flight: DropFlight | None = None) -> DropFlight:
+    """A flight from a drop ``at - 0.1`` s whose feet sank ``depth`` [m] and stopped,
+    landing at ``at`` [s] (on ``flight``, or a new one)."""
+    flight = DropFlight() if flight is None else flight
+    flight.update(True, _estimate(at - 0.1, 0.0))
+    flight.update(False, _estimate(at - 0.05, -2.0 * SINK_SPEED, 0.5 * depth))
     start = at - (LAND_TICKS - 1) * DT
     for k in range(LAND_TICKS):
-        flight.update(False, _estimate(start + k * DT, 0.0))
+        flight.update(False, _estimate(start + k * DT, 0.0, depth))
     assert not flight.flying
     return flight
 
 
-def test_the_flight_records_its_landing() -> None:
-    flight = _landed_flight(0.1)
+def test_the_flight_records_its_landing_and_its_depth() -> None:
+    """The landing's time, and the fall as the feet's height lost from the drop to it."""
+    flight = _landed_flight(0.1, depth=0.076)
     assert flight.landed == pytest.approx(0.1)
+    assert flight.depth == pytest.approx(0.076)
+    assert flight.depths == [flight.depth]
     flight.reset()
     assert flight.landed is None
+    assert flight.depth is None
+
+
+def test_a_shallow_landing_keeps_the_plans_loads() -> None:
+    """A fall shallower than ``depth`` (the deck clears the edge at any pitch) is ridden on
+    the plan's centre of pressure; a deeper one flat-footed."""
+    depth = 0.05
+    shallow = LandingLoads(_landed_flight(0.1, depth=0.041), CONTACT_FOOT, LANDING_S, depth)
+    assert shallow(HEELS, 0.15) is HEELS
+    deep = LandingLoads(_landed_flight(0.1, depth=0.076), CONTACT_FOOT, LANDING_S, depth)
+    out = deep(HEELS, 0.15)
+    np.testing.assert_allclose(out[0], out[1])
+
+
+def test_the_landing_ends_at_the_next_take_off() -> None:
+    """A drop within the window ends the landing's loads (no foot stands in a flight);
+    the next landing's own depth then decides."""
+    flight = _landed_flight(0.1, depth=0.076)
+    loads = LandingLoads(flight, CONTACT_FOOT, LANDING_S, 0.05)
+    assert loads.landing(0.15)
+    flight.update(True, _estimate(0.16, 0.0, 0.076))
+    assert flight.flying
+    assert not loads.landing(0.17)
+    _landed_flight(0.25, depth=0.03, flight=flight)  # the next: a shallow one
+    assert not loads.landing(0.26)
 
 
 def test_no_landing_no_change() -> None:
@@ -107,6 +137,8 @@ def test_the_whole_body_targets_carry_the_landed_split() -> None:
     np.testing.assert_array_equal(later.site_forces, HEELS)
 
 
-def test_a_window_must_be_positive() -> None:
+def test_a_window_must_be_positive_and_a_depth_not_negative() -> None:
     with pytest.raises(ValueError, match="window"):
         LandingLoads(DropFlight(), CONTACT_FOOT, 0.0)
+    with pytest.raises(ValueError, match="depth"):
+        LandingLoads(DropFlight(), CONTACT_FOOT, LANDING_S, -0.01)

@@ -70,6 +70,10 @@ class DropFlight:
         starts: When each flight of the ride began [s] (``summary.json``'s ``flights_s``).
         landed: When the last flight landed [s] (None: none yet), for
             :mod:`~ridempc.mpc.landing`.
+        depth: How far the last flight fell [m] (None: none landed yet): the feet's mean
+            height at the drop less theirs at the landing, both from the estimate (the IMU,
+            the VIO and the legs' kinematics), so a step's height as the rider measured it.
+        depths: Each landed flight's ``depth`` [m] (``summary.json``'s ``flight_depths_m``).
 
     Args:
         watch: The drop's watch, observed before this stage each tick (None: ``update``
@@ -94,10 +98,13 @@ class DropFlight:
         self._now = 0.0  # [s] the last tick observed
         self._start: float | None = None
         self._offsets = np.zeros((0, 3))  # [m] each foot from the base, at the drop
+        self._height = 0.0  # [m] the feet's mean height at the drop
         self._sank = False  # whether a foot has sunk faster than SINK_SPEED in this flight
         self._stopped = 0
         self.starts: list[float] = []  # [s] when each flight of the ride began
         self.landed: float | None = None  # [s] when the last flight landed
+        self.depth: float | None = None  # [m] how far the last flight fell
+        self.depths: list[float] = []  # [m] how far each landed flight fell
 
     @property
     def flying(self) -> bool:
@@ -110,6 +117,8 @@ class DropFlight:
         self._stopped = 0
         self.starts = []
         self.landed = None
+        self.depth = None
+        self.depths = []
 
     def update(self, dropped: bool, estimate: EstimatedState) -> bool:
         """Take this tick's drop detection and estimate; whether the drop is in the air.
@@ -127,6 +136,7 @@ class DropFlight:
                 self._start = estimate.time
                 self.starts.append(estimate.time)
                 self._offsets = estimate.foot_position - estimate.base_position
+                self._height = float(np.mean(estimate.foot_position[:, 2]))
                 self._sank = False
                 self._stopped = 0
             return self.flying
@@ -137,6 +147,8 @@ class DropFlight:
         if self._stopped >= LAND_TICKS:
             self._start = None
             self.landed = estimate.time
+            self.depth = self._height - float(np.mean(estimate.foot_position[:, 2]))
+            self.depths.append(self.depth)
         return self.flying
 
     def observe(self, tick: ControlTick) -> None:

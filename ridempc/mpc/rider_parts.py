@@ -248,7 +248,9 @@ class RiderParts(Controller):
         )
         landing = None  # the landing ridden flat-footed (``[stages.flight] landing``)
         if self.flight is not None and stages.flight is not None and stages.flight.landing:
-            landing = LandingLoads(self.flight, self._contact_foot, stages.flight.landing)
+            landing = LandingLoads(
+                self.flight, self._contact_foot, stages.flight.landing, stages.flight.landing_depth
+            )
         self.targets = TargetsFromPlan(  # the whole-body QP's targets from the plan in force
             self._read_plan, self.feet_targets, self.flight, self.shoes, self._sites_match, landing
         )

@@ -65,6 +65,7 @@ class RiderReports(RiderParts):
         out["impulse_max"] = self.impulse.peak if self.impulse is not None else None
         out["impulse_max_time_s"] = self.impulse.peak_time if self.impulse is not None else None
         out["flights_s"] = list(self.flight.starts) if self.flight is not None else None
+        out["flight_depths_m"] = list(self.flight.depths) if self.flight is not None else None
         out["safe_hold"] = (
             None
             if self._hold_reason is None
