@@ -190,6 +190,14 @@ class SettleStage(_Frozen):
     duration: Positive = Field(le=10.0, description="Settle over the feet in this [s].")
 
 
+class PayloadStage(_Frozen):
+    mass_from: Literal["loads", "prediction"] = Field(
+        default="loads",
+        description="The rider's mass weighed by the feet's loads or by the MPC's vertical "
+        "prediction error.",
+    )
+
+
 class DisturbanceStage(_Frozen):
     time_constant: Positive = Field(le=10.0, description="Low-pass of the estimate [s].")
     max_linear: Positive = Field(le=100.0, description="Bound on a linear row [m/s^2].")
@@ -253,7 +261,7 @@ class Stages(_Frozen):
     swing_force_hold: SwingForceStage | None = None
     push_weights: PushWeightsStage | None = None
     settle: SettleStage | None = None
-    payload: Used | None = None
+    payload: PayloadStage | None = None
     disturbance: DisturbanceStage | None = None
     takeover: TakeoverStage | None = None
     drop: Used | None = None

@@ -208,6 +208,15 @@ class PayloadEstimator:
         self._vcom: Array | None = None  # [m/s] the model's centre-of-mass velocity, last step
         self._readings = 0  # the readings taken while the backup rode (the running mean's k)
         self.mean_shift = np.zeros(3)  # [m] the offset readings' running mean, base frame
+        self._weighed: float | None = None  # [kg] the mass weighed another way, if any
+
+    def weigh(self, mass: float) -> None:
+        """Take the rider's mass beyond the model's, :math:`\\Delta m` [kg], from another
+        reading than the feet's loads (:mod:`ridempc.mpc.vertical_weight`): the loads are
+        not read from then on, and the centre of mass's offset stays the model's (it is
+        read from the loads' split between heel and toe, which needs their scale)."""
+        self._weighed = mass
+        self.estimate = PayloadEstimate(mass, self.estimate.shift, self.mass0)
 
     def _com_velocity(self, q: Array, v: Array | None) -> Array | None:
         """The nominal model's centre-of-mass velocity [m/s] (world), None without ``v``."""
@@ -244,6 +253,9 @@ class PayloadEstimator:
         held where no reading came in with every foot in contact. ``open_loop``: the
         estimate closes no loop through the balance (the backup rides): the running mean
         (module docstring)."""
+        if self._weighed is not None:  # weighed another way: the loads are not read
+            self.reset()
+            return self.estimate
         vcom = self._com_velocity(q, v)
         if self._sum is None:
             self._vcom = None  # a gap: the next reading starts a new run

@@ -6,7 +6,10 @@ the whole-body QP read (their links' inertias), while the rider balances (holds 
 held through a manoeuvre, whose accelerations move the centre of pressure off the centre of
 mass), and its weight the MPC's vertical rate carries as a drift
 (:class:`~ridempc.mpc.stages.base.DriftSource`); a
-:class:`~ridempc.mpc.stages.base.TickObserver` and a drift source.
+:class:`~ridempc.mpc.stages.base.TickObserver` and a drift source. With a
+:class:`~ridempc.mpc.vertical_weight.VerticalWeight` the mass is weighed by the MPC's own
+vertical prediction error instead of the feet's loads (the pair's ``[stages.payload]
+mass_from = "prediction"``), updated with the drift and in the models from the next MPC tick.
 """
 
 from __future__ import annotations
@@ -20,10 +23,23 @@ from numpy.typing import NDArray
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.stages.base import ControlTick, MpcTick
+from ridempc.mpc.vertical_weight import VerticalWeight
+from ridempc.pair_description import PayloadStage
 
-__all__ = ["PayloadModels"]
+__all__ = ["PayloadModels", "weighed"]
 
 Array = NDArray[np.float64]
+
+
+def weighed(
+    stage: PayloadStage | None, vz: int, payload: PayloadEstimator | None, dt: float
+) -> VerticalWeight | None:
+    """The mass weighed by the MPC's vertical prediction error, if the pair's payload stage
+    asks for it (``mass_from = "prediction"``), for the vertical rate's row ``vz`` and the
+    MPC's step ``dt`` [s]."""
+    if stage is None or payload is None or stage.mass_from != "prediction":
+        return None
+    return VerticalWeight(vz, payload.mass0, dt)
 
 
 class PayloadModels:
@@ -35,6 +51,7 @@ class PayloadModels:
             the whole-body QP's).
         com: The estimate's centre of mass [m], world frame (from the map's model).
         vz: The vertical rate's row in the MPC's state.
+        weight: The mass weighed by the vertical prediction error, or None (the loads').
     """
 
     def __init__(
@@ -43,8 +60,10 @@ class PayloadModels:
         models: Sequence[pin.Model],
         com: Callable[[EstimatedState], Array],
         vz: int,
+        weight: VerticalWeight | None = None,
     ) -> None:
         self.payload, self._models, self._com, self._vz = payload, tuple(models), com, vz
+        self.weight = weight
         self._open_loop = False  # the backup rode the last control tick: no loop closed
 
     def observe(self, tick: ControlTick) -> None:
@@ -70,5 +89,8 @@ class PayloadModels:
         tick.diagnostics.update(payload_kg=payload.mass)
 
     def drift(self, tick: MpcTick, x0: Array) -> Array | None:
-        """The payload's weight on the vertical rate."""
+        """The payload's weight on the vertical rate (first weighed, with a
+        :class:`~ridempc.mpc.vertical_weight.VerticalWeight`)."""
+        if self.weight is not None:
+            self.payload.weigh(self.weight.update(tick, x0))
         return self.payload.estimate.drift(len(x0), self._vz)
