@@ -63,8 +63,6 @@ from ridempc.mpc.manoeuvre import HOLD, REPUSH, REPUSH_BAND
 from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
 from ridempc.mpc.push_handover import deviation_deferred
-from ridempc.mpc.push_liftoff import stroke_ending
-from ridempc.mpc.push_roll import repush_steering
 from ridempc.mpc.rider_parts import BACKUP_LAW, MPC_DIVIDER
 from ridempc.mpc.rider_reports import RiderReports
 from ridempc.mpc.stages.base import ControlTick, MpcTick
@@ -217,8 +215,6 @@ class MpcRider(RiderReports):
             observer.observe(tick)
         repushing, start = self.manoeuvre.kind == REPUSH, self.manoeuvre.target - REPUSH_BAND
         stroke = deviation_deferred(repushing, self._support, self._speed(estimate), start)
-        t_ref = self.manoeuvre.reference_time(sensors.time)  # a full stroke's end: push_liftoff
-        stroke = stroke or stroke_ending(repushing, self.mpc.reference, t_ref)
         check = HandoverCheck(
             self.book.plan,
             self._diagnostics.get("wbc_slack", 0.0),
@@ -286,11 +282,8 @@ class MpcRider(RiderReports):
         )
         if self.payload_models is not None:
             self.payload_models.absorb(tick)
-        steering: bool | Array = balancing  # a re-push's strokes go straight (mpc/push_roll.py)
-        if not balancing and self.manoeuvre.kind == REPUSH:
-            settings = self.mpc.settings
-            nodes = settings.horizon + 1
-            steering = repush_steering(self.mpc.reference, t_ref, nodes, settings.dt)
+        pushing = Contact.GROUND in self.book.contacts  # a foot on the ground goes straight
+        steering = balancing or (self.manoeuvre.kind == REPUSH and not pushing)
         if self.shoes is not None and self._slope_trim:  # a slope's lost speed: mpc/slope_trim.py
             riding, slopes = not self.handover.on_backup, self.shoes.slopes.angles
             self.shoes.trim.update(now, command.velocity, rider_speed, slopes, riding)

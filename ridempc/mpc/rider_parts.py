@@ -354,7 +354,7 @@ class RiderParts(Controller):
             Coasting(layout, blend),
             RollCommand(mpc, layout),
             blend,
-            Turn(layout, mpc),
+            Turn(layout),
             CrouchShaper(self.crouch, layout.names["com_z"]) if self.crouch is not None else None,
             LeanShaper(mpc, layout) if self.lean is not None else None,
             self._shoe_lines,

@@ -127,9 +127,7 @@ def build_and_run(mpc: LinearMpc, shapers: Iterable[ProblemShaper], inputs: Buil
     build = time.perf_counter() - started
     qp = mpc.qp
     plan = qp.finish(qp.start(problem), qp.run())
-    # judged in the MPC's own tolerances (Bryson's), not a push's tighter tracking weights
-    # (mpc/push_weights.py): a full stroke ends with the body ahead of the board
-    weights, reference = mpc.state_weights, problem.state_reference
+    weights, reference = problem.state_weights, problem.state_reference
     gap = deviation(problem.initial_state, reference[0], weights)
     expected = deviation(plan.states[1], reference[1], weights)
     return Built(plan, problem.contacts[0], build, qp.failures, problem, gap, expected)

@@ -114,19 +114,18 @@ class CommandHorizon:
         command: Command,
         now: float,
         speed: float,
-        steering: bool | Array,
+        steering: bool,
         limit: Callable[[Array], Array] | None,
         names: dict[str, int],
     ) -> tuple[Array, Array]:
         """The commanded deck roll at the horizon's nodes [rad] and the turn over its steps
-        [rad/s]: the roll commanded, plus, while ``steering`` (balancing, or, per node, a
-        re-push's nodes out of its strokes), the roll that steers the commanded yaw rate,
-        held within ``limit`` (the stance's, or None); the turn commanded plus the one the
-        roll steers at the board's ``speed`` [m/s] (``names``: the MPC's state columns)."""
+        [rad/s]: the roll commanded, plus, while ``steering`` (balancing, or a re-push with
+        no foot on the ground), the roll that steers the commanded yaw rate, held within
+        ``limit`` (the stance's, or None); the turn commanded plus the one the roll steers
+        at the board's ``speed`` [m/s] (``names``: the MPC's state columns)."""
         roll = self.roll_horizon(command, now)
-        if np.any(steering):
-            steers = np.asarray(steering, dtype=float)
-            roll = roll + steers * self.steering_roll(command, now, speed)
+        if steering:
+            roll = roll + self.steering_roll(command, now, speed)
         if limit is not None:
             roll = limit(roll)
         turn = self.yaw_rate_horizon(command, now) + self.roll_turn(roll, speed, names)

@@ -28,7 +28,6 @@ from ridempc.boards.canonical import BoardState
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.controller import LinearMpc
 from ridempc.mpc.pairs import MpcPair
-from ridempc.mpc.push_roll import RollRate
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.stages.base import MpcTick
 from ridempc.mpc.stance import StanceLimit
@@ -120,34 +119,21 @@ class RollDrift:
 class StanceRoll:
     """The commanded deck roll held within what the stance can hold, in four-leg
     balancing, from the four feet's estimated places (the last bounds while one is off the
-    deck); elsewhere (a push) within the paper's largest roll and laid in at the rate the
-    stance follows (:class:`~ridempc.mpc.push_roll.RollRate`; module docstring).
+    deck); as commanded elsewhere (module docstring).
 
     Args:
         limit: The stance's limit.
         sides: The stance's sides.
         com: The estimate's centre of mass [m], world frame.
-        dt: The MPC's step [s].
     """
 
     def __init__(
-        self,
-        limit: StanceLimit,
-        sides: DeckSides,
-        com: Callable[[EstimatedState], Array],
-        dt: float,
+        self, limit: StanceLimit, sides: DeckSides, com: Callable[[EstimatedState], Array]
     ) -> None:
         self.limit, self._sides, self._com = limit, sides, com
-        self._dt, self._rate = dt, RollRate()
 
     def __call__(self, roll: Array, tick: MpcTick) -> Array:
         """``roll`` [rad] at the horizon's nodes, held within the stance's bounds."""
-        held = self._stance(roll, tick)
-        if tick.balancing:
-            return self._rate.follow(held, tick.now)
-        return self._rate(held, tick.now, self._dt)
-
-    def _stance(self, roll: Array, tick: MpcTick) -> Array:
         limit, estimate = self.limit, tick.estimate
         board = estimate.board
         if board is None:
@@ -212,5 +198,5 @@ def deck_stages(
     return DeckStages(
         steers.steer_gain if steers is not None else None,
         RollDrift(observer, sides, mpc.settings.dt) if observer is not None else None,
-        StanceRoll(limit, sides, com, mpc.settings.dt) if limit is not None else None,
+        StanceRoll(limit, sides, com) if limit is not None else None,
     )

@@ -87,13 +87,13 @@ class CommandedFrame:
         mapped: EstimatedState,
         t_ref: float,
         coasting: bool,
-        steering: bool | Array,
+        steering: bool,
     ) -> tuple[Array, Array, Array]:
         """The commanded roll at the horizon's nodes [rad], the turn over its steps
         [rad/s] and the state ``mapped`` (the estimate as the MPC sees it) in the library
         frame moved onto the board at the reference's time ``t_ref`` [s]; ``steering``:
-        whether the deck's roll may steer (the rider balancing), or per node (a re-push's
-        nodes out of its strokes, :mod:`~ridempc.mpc.push_steer`)."""
+        whether the deck's roll may steer (the rider balancing, or re-pushing off the
+        ground)."""
         now, speed = tick.now, tick.speed
         limit = partial(self.stance_roll, tick=tick) if self.stance_roll is not None else None
         names = self.layout.names

@@ -17,16 +17,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ridempc.mpc.controller import LinearMpc
-from ridempc.mpc.manoeuvre import (
-    MOVING,
-    REPUSH,
-    REPUSH_BAND,
-    Manoeuvre,
-    ManoeuvreSelector,
-    StateLayout,
-)
+from ridempc.mpc.manoeuvre import REPUSH, Manoeuvre, ManoeuvreSelector, StateLayout
 from ridempc.mpc.pairs import MpcPair
-from ridempc.mpc.push_least import repush_start
 from ridempc.mpc.push_side import PushSide, first_stride
 from ridempc.mpc.push_speed import StrokeSpeedLoop
 from ridempc.mpc.stages.commands import CommandHorizon
@@ -60,23 +52,6 @@ class ManoeuvreChoice:
         self._pair, self._push_side, self._commands = pair, push_side, commands
         self.speed_loop = StrokeSpeedLoop()
 
-    def _least_start(self, commanded: float) -> float:
-        """How much sooner [m/s] than :data:`~ridempc.mpc.manoeuvre.REPUSH_BAND` below the
-        ``commanded`` speed [m/s] a coasting board is pushed again, so that its entry's
-        first stroke lands on a board still rolling (:mod:`~ridempc.mpc.push_least`); 0
-        where the ride does not push again."""
-        selector = self._selector
-        targets = selector.targets.get(REPUSH)
-        if not selector.holds_speed or not targets or commanded < MOVING:
-            return 0.0
-        target = min(max(commanded, targets[0]), targets[-1])
-        pair, prefixes = self._pair.pair, self._pair.platform_prefixes
-        column = self._layout.speed(prefixes[0]) if prefixes else None
-        if column is None:
-            return 0.0
-        floor = repush_start(pair.robot, pair.board, target, column)
-        return max(0.0, min(floor, commanded) - (commanded - REPUSH_BAND))
-
     def __call__(
         self,
         manoeuvre: Manoeuvre,
@@ -98,8 +73,7 @@ class ManoeuvreChoice:
         else:
             loop.reset()
         if wanted is manoeuvre and coasting:  # slowed: push again
-            early = self._least_start(command.velocity)  # mpc/push_least.py
-            wanted = selector.repush(command, wanted, now, speed, max(loop.gain, early))
+            wanted = selector.repush(command, wanted, now, speed, loop.gain)
             if wanted is not manoeuvre:  # a stride ends: the loop's sample, its gain asked
                 wanted = replace(wanted, gain=loop.stride(now, command.velocity))
         if wanted is manoeuvre:

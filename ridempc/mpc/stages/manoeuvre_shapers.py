@@ -10,7 +10,7 @@ in the order they act:
    shifted to balance it;
 3. :class:`RepushBlend`: a re-push's reference blended in from where the coast left the
    rider (:mod:`~ridempc.mpc.switch_blend`);
-4. :class:`Turn`: the reference turned at the commanded yaw rates, a stroke's forces with it.
+4. :class:`Turn`: the reference turned at the commanded yaw rates.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ import numpy as np
 from ridempc.mpc.controller import LinearMpc
 from ridempc.mpc.manoeuvre import REPUSH, ManoeuvreSelector, StateLayout
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.push_frame import step_turns, with_turned_forces
 from ridempc.mpc.push_gain import PushAnchor, shifted_speeds
 from ridempc.mpc.reference import MotionReference
 from ridempc.mpc.stages.build import BuildInputs
@@ -103,18 +102,10 @@ class RollCommand:
 
 
 class Turn:
-    """The reference turned at the commanded yaw rates, by the turn so far; a stroke's forces
-    and its ground pyramid with it (:mod:`~ridempc.mpc.push_frame`)."""
+    """The reference turned at the commanded yaw rates, by the turn so far."""
 
-    def __init__(self, layout: StateLayout, mpc: LinearMpc | None = None) -> None:
-        self._layout, self._mpc = layout, mpc
+    def __init__(self, layout: StateLayout) -> None:
+        self._layout = layout
 
     def __call__(self, problem: MpcProblem, inputs: BuildInputs) -> MpcProblem:
-        problem = ManoeuvreSelector.with_turn(problem, self._layout, inputs.turn, inputs.turned)
-        if self._mpc is None:
-            return problem
-        steps = problem.input_reference.shape[0]
-        reference = self._mpc.reference
-        contacts = reference.sample(inputs.t_ref, steps, problem.dt).contacts
-        turns = step_turns(inputs.turn, inputs.turned, steps, problem.dt)
-        return with_turned_forces(problem, reference.force_index, contacts, turns)
+        return ManoeuvreSelector.with_turn(problem, self._layout, inputs.turn, inputs.turned)
