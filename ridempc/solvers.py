@@ -52,12 +52,15 @@ class QpKind:
         solver: The solver it runs on: the fastest on its recorded problems.
         solvers: Those the controller can run it on.
         compared: Those ``ridempc bench`` times on its recorded problems besides.
+        rescue: The solver of its elastic form when its own gives no plan
+            (:mod:`ridempc.mpc.elastic`; None: none).
     """
 
     name: str
     solver: str
     solvers: tuple[str, ...]
     compared: tuple[str, ...]
+    rescue: str | None = None
 
 
 # Measured by ``ridempc bench`` (cassie-hovershoes, velocity-steps, 3 s, machine reference
@@ -76,6 +79,7 @@ QP_KINDS: MappingProxyType[str, QpKind] = MappingProxyType(
             solver="osqp",
             solvers=("osqp",),
             compared=("proxqp", "daqp", "piqp", "clarabel", "hpipm (casadi)"),
+            rescue="piqp",  # interior point: 13-15 iterations where OSQP's budget ran out
         ),
         "wbc": QpKind("wbc", solver="daqp", solvers=("daqp", "osqp"), compared=("proxqp",)),
     }

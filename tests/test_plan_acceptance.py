@@ -1,11 +1,16 @@
-"""A plan OSQP did not fully converge: continued, then used only within its residual bounds."""
+"""A plan OSQP did not fully converge: continued, then used only within its residual bounds;
+a QP that still gives no plan, or is infeasible, solved in its elastic form."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from helpers import osqp_tight
 
+from ridempc.mpc.elastic import ElasticRescue, elastic_problem
 from ridempc.mpc.plan_acceptance import Acceptance
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.qp import MpcQP
@@ -80,9 +85,9 @@ def test_an_unconverged_solve_within_its_bounds_gives_a_plan() -> None:
 def test_an_unconverged_solve_beyond_its_bounds_falls_back() -> None:
     problem = _pushed_cart()
     strict = Acceptance(extra_iterations=5, residual=0.0, change=0.0)
-    plan = MpcQP(problem, max_iter=10, acceptance=strict).solve(problem)
+    plan = MpcQP(problem, max_iter=10, acceptance=strict, rescue=None).solve(problem)
     assert plan.fallback and plan.status == "maximum iterations reached"
-    off = MpcQP(problem, max_iter=10, acceptance=None).solve(problem)  # no continuation
+    off = MpcQP(problem, max_iter=10, acceptance=None, rescue=None).solve(problem)
     assert off.fallback and off.iterations == 10
 
 
@@ -92,3 +97,44 @@ def test_a_converged_solve_is_untouched_by_the_rule() -> None:
     assert plans[0].status == plans[1].status == "solved"
     assert plans[0].iterations == plans[1].iterations
     np.testing.assert_array_equal(plans[0].inputs, plans[1].inputs)
+
+
+def test_an_infeasible_qp_gets_a_plan_with_slack() -> None:
+    problem = _pushed_cart()
+    lower = problem.constraint_lower.copy()
+    lower[:, 0] = 12.0  # the forces' sum above 12 N, each force's box at most 5 N
+    infeasible = replace(problem, constraint_lower=lower, constraint_upper=lower + 1.0)
+    qp = MpcQP(infeasible)
+    plan = qp.solve(infeasible)
+    assert not plan.fallback and "elastic" in plan.status and qp.failures == 0
+    # the least violation: the boxes held (to the interior point's accuracy), the sum gave
+    assert np.all(np.abs(plan.inputs) <= 5.0 + 1e-3)
+    assert plan.inputs.sum(axis=1) == pytest.approx(np.full(HORIZON, 10.0), abs=1e-3)
+    off = MpcQP(infeasible, rescue=None).solve(infeasible)
+    assert off.fallback and "infeasible" in off.status
+
+
+def test_a_feasible_rescue_is_the_qps_own_optimum() -> None:
+    problem = _pushed_cart()
+    qp = MpcQP(problem, max_iter=10, acceptance=None)  # no plan from OSQP itself
+    plan = qp.solve(problem)
+    assert not plan.fallback and plan.status.startswith("maximum iterations reached, elastic")
+    tolerance = 1.0 / np.sqrt(problem.input_weights)
+    error = np.abs(plan.first_input - _optimum_first_input(qp, problem)) / tolerance
+    assert error.max() < 1e-4  # the exact penalty: no slack where the QP is feasible
+
+
+def test_the_elastic_form_softens_only_the_inequality_rows() -> None:
+    hessian = sp.identity(2, format="csc")
+    rows = sp.csc_matrix(np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]))
+    arrays, slacks = elastic_problem(
+        hessian, rows, np.array([1.0, -np.inf, -np.inf]), np.array([1.0, 2.0, np.inf]), 10.0
+    )
+    assert slacks == 1  # the equality is hard, the free row has no slack
+    assert arrays["A"].shape == (1, 3) and arrays["G"].shape == (1, 3)
+    assert list(arrays["q"]) == [0.0, 0.0, 10.0]
+    solution = ElasticRescue().solve(
+        hessian, rows, np.array([1.0, -np.inf, -np.inf]), np.array([1.0, 2.0, np.inf])
+    )
+    assert solution.z is not None and solution.z == pytest.approx([1.0, 0.0], abs=1e-6)
+    assert solution.slack == pytest.approx(0.0, abs=1e-8)

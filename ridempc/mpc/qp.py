@@ -31,9 +31,12 @@ that new bounds never re-factor the KKT matrix), and each solve is warm-started 
 previous plan shifted by one step (primal and dual). A solve that does not end ``solved``
 within the iteration budget continues for a few more iterations and its plan is used
 if it converges then or if its residuals are within the bounds of
-:class:`~ridempc.mpc.plan_acceptance.Acceptance`; any other (or one beyond an optional
-wall-clock time limit) returns the previous plan shifted by one step, flagged as a
-fallback, and counts as a failure.
+:class:`~ridempc.mpc.plan_acceptance.Acceptance`. A solve that still gives no plan (or
+that OSQP finds infeasible) is solved again in its elastic form by an interior point
+method (:mod:`ridempc.mpc.elastic`: the inequality rows with exact-penalty slacks, always
+feasible, the QP's own solution when the QP is feasible). Only a solve beyond an optional
+wall-clock time limit, or one the rescue too gives no plan, returns the previous plan
+shifted by one step, flagged as a fallback, and counts as a failure.
 """
 
 from __future__ import annotations
@@ -48,6 +51,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ridempc.interrupts import osqp_returned
+from ridempc.mpc.elastic import ElasticRescue
 from ridempc.mpc.plan import Plan, shift_plan
 from ridempc.mpc.plan_acceptance import Acceptance
 from ridempc.mpc.problem import MpcProblem
@@ -102,6 +106,12 @@ DEFAULT_SETTINGS: dict[str, Any] = {
 _SOLVED = osqp.SolverStatus.OSQP_SOLVED
 # the statuses of a solve that ended its budget unconverged (continued, see Acceptance)
 _UNCONVERGED = (osqp.SolverStatus.OSQP_MAX_ITER_REACHED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE)
+# the statuses of a solve that gave no plan and is solved again in its elastic form
+_RESCUED = (
+    *_UNCONVERGED,
+    osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE,
+    osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE_INACCURATE,
+)
 # OSQP's infinity, to which its Python ``update`` clips the bounds (written here as it does)
 _INFINITY = float(osqp.constant("OSQP_INFTY"))
 _PATTERN_TOLERANCE = 1e-9  # values this small outside the pattern are round-off
@@ -220,7 +230,9 @@ class MpcQP:
                 matrix), False gives each row the class its bounds ask for, and
                 ``acceptance``: the rule for an unconverged solve
                 (:class:`~ridempc.mpc.plan_acceptance.Acceptance`, default its own; None:
-                every unconverged solve fails).
+                no unconverged solve accepted), and ``rescue``: the elastic solve of a QP
+                that gives no plan (:class:`~ridempc.mpc.elastic.ElasticRescue`, default
+                its own; None: none, the solve fails).
         """
         self.horizon, self.nx, self.nu = problem.horizon, problem.nx, problem.nu
         self.n_constraints = problem.n_constraints
@@ -229,6 +241,7 @@ class MpcQP:
         held = bool(settings.pop("row_classes", True))
         acceptance = settings.pop("acceptance", Acceptance())
         self.acceptance: Acceptance = Acceptance(0) if acceptance is None else acceptance
+        self.rescue: ElasticRescue | None = settings.pop("rescue", ElasticRescue())
         self.settings = {**DEFAULT_SETTINGS, **settings}
         limit = self.settings.get("time_limit")
         self.time_limit: float | None = None if limit is None else float(limit)
@@ -583,6 +596,13 @@ class MpcQP:
         )
         return result, Acceptance.status(status) if accepted else status, iterations, accepted
 
+    def _rescues(self, outcome: SolveOutcome) -> bool:
+        """Whether a solve that gave no plan is solved again in its elastic form: one
+        OSQP ended unconverged or found infeasible (not a deadline, an interrupt or a
+        solver error)."""
+        result = outcome.result
+        return self.rescue is not None and result is not None and result.info.status_val in _RESCUED
+
     def _run_osqp(self) -> _Result:
         """OSQP's solve on the extension's solver: its solution and info as OSQP's Python
         ``solve`` returns them, without the copy of every info field it makes per call."""
@@ -601,12 +621,19 @@ class MpcQP:
         if ok and self.time_limit is not None and elapsed > self.time_limit:
             status, ok = f"time limit exceeded ({elapsed * 1e3:.1f} ms)", False
         problem, result = started.problem, outcome.result
+        scaled = np.asarray(result.x, dtype=float) if ok else None
         if ok:
-            z = started.reference + self._scale * np.asarray(result.x, dtype=float)
+            self._previous_dual = np.asarray(result.y, dtype=float).copy()
+        elif self._rescues(outcome):
+            assert self.rescue is not None
+            rescued = self.rescue.solve(*self.matrices(problem), *self.bounds(problem))
+            if rescued.z is not None:  # the previous dual kept for the next warm start
+                scaled, status = rescued.z, f"{status}, elastic (slack {rescued.slack:.2g})"
+        if scaled is not None:
+            z = started.reference + self._scale * scaled
             states, inputs = self._unpack(z)
             elapsed += time.perf_counter() - begin
             plan = Plan(states, inputs, inputs[0].copy(), status, elapsed, False, iterations)
-            self._previous_dual = np.asarray(result.y, dtype=float).copy()
         else:
             self.failures += 1
             elapsed += time.perf_counter() - begin
