@@ -28,6 +28,7 @@ Clarabel's optimum to 1e-5 tolerances with slacks below 1e-10.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -129,10 +130,7 @@ class ElasticRescue:
         self, hessian: sp.spmatrix, constraints: sp.spmatrix, lower: Array, upper: Array
     ) -> ElasticSolution:
         """The elastic QP of :math:`\\min \\tfrac12 z^\\top P z`, :math:`l \\le A z \\le u`
-        solved from a cold start (its :math:`z`, None if the solver failed).
-        """
-        import time
-
+        solved from a cold start (its :math:`z`, None if the solver failed)."""
         import qpsolvers
 
         arrays, m = elastic_problem(hessian, constraints, lower, upper, self.penalty)
