@@ -5,7 +5,9 @@ Each kind of QP (:data:`QP_KINDS`) names the solver measured fastest on its reco
 problems (:attr:`QpKind.solver`), the solvers the controller can run it on
 (:attr:`QpKind.solvers`, e.g. ``ridempc bench --wbc-solver osqp`` to measure the choice in
 the closed loop) and the ones the bench only compares (:attr:`QpKind.compared`). The MPC,
-the whole-body controller and the bench all ask here (:func:`solver_for`).
+the whole-body controller and the bench all ask here (:func:`solver_for`). The MPC's QP
+also names its rescue solver (:attr:`QpKind.rescue`): the interior point method that
+solves its elastic form when OSQP gives no plan (:mod:`ridempc.mpc.elastic`).
 
 Dense QPs :math:`\\min \\tfrac12 z^\\top P z + q^\\top z`, :math:`l \\le A z \\le u`
 (:class:`DenseQp`, the whole-body QP) go to a backend by name through
