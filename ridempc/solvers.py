@@ -5,7 +5,9 @@ Each kind of QP (:data:`QP_KINDS`) names the solver measured fastest on its reco
 problems (:attr:`QpKind.solver`), the solvers the controller can run it on
 (:attr:`QpKind.solvers`, e.g. ``ridempc bench --wbc-solver osqp`` to measure the choice in
 the closed loop) and the ones the bench only compares (:attr:`QpKind.compared`). The MPC,
-the whole-body controller and the bench all ask here (:func:`solver_for`).
+the whole-body controller and the bench all ask here (:func:`solver_for`). The MPC's QP
+also names its rescue solver (:attr:`QpKind.rescue`): the interior point method that
+solves its elastic form when OSQP gives no plan (:mod:`ridempc.mpc.elastic`).
 
 Dense QPs :math:`\\min \\tfrac12 z^\\top P z + q^\\top z`, :math:`l \\le A z \\le u`
 (:class:`DenseQp`, the whole-body QP) go to a backend by name through
@@ -52,12 +54,15 @@ class QpKind:
         solver: The solver it runs on: the fastest on its recorded problems.
         solvers: Those the controller can run it on.
         compared: Those ``ridempc bench`` times on its recorded problems besides.
+        rescue: The solver of its elastic form when its own gives no plan
+            (:mod:`ridempc.mpc.elastic`; None: none).
     """
 
     name: str
     solver: str
     solvers: tuple[str, ...]
     compared: tuple[str, ...]
+    rescue: str | None = None
 
 
 # Measured by ``ridempc bench`` (cassie-hovershoes, velocity-steps, 3 s, machine reference
@@ -76,6 +81,7 @@ QP_KINDS: MappingProxyType[str, QpKind] = MappingProxyType(
             solver="osqp",
             solvers=("osqp",),
             compared=("proxqp", "daqp", "piqp", "clarabel", "hpipm (casadi)"),
+            rescue="piqp",  # interior point: 13-15 iterations where OSQP's budget ran out
         ),
         "wbc": QpKind("wbc", solver="daqp", solvers=("daqp", "osqp"), compared=("proxqp",)),
     }

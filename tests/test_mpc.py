@@ -28,6 +28,7 @@ from ridempc.mpc import (
 )
 from ridempc.mpc.friction import ROWS_PER_CONTACT
 from ridempc.mpc.manoeuvre import RETARGET_BAND, Manoeuvre, ManoeuvreSelector, StateLayout
+from ridempc.mpc.plan_acceptance import Acceptance
 from ridempc.scenarios.scenario import Command
 from ridempc.trajopt.schedule import Contact
 
@@ -280,6 +281,7 @@ def test_infeasible_update_falls_back_to_the_shifted_plan(skate_mpc: LinearMpc) 
     reference = skate_mpc.reference
     good = skate_mpc.problem(0.0, reference.states[0])
     qp = skate_mpc.build_qp(good)
+    qp.rescue = None  # the fallback itself (the elastic rescue: tests/test_plan_acceptance.py)
     previous = qp.solve(good)
     assert not previous.fallback and qp.failures == 0
     # Contradictory: a standing foot must push down harder than its pyramid allows.
@@ -302,9 +304,11 @@ def test_infeasible_update_falls_back_to_the_shifted_plan(skate_mpc: LinearMpc) 
 
 
 def test_the_solve_budget_is_iterations_not_wall_time(skate_mpc: LinearMpc) -> None:
-    """Without a time limit a solve cut at ``max_iter`` falls back, whatever the load."""
+    """Without a time limit a solve cut at ``max_iter`` (neither continued nor rescued)
+    falls back, whatever the load."""
     good = skate_mpc.problem(0.0, skate_mpc.reference.states[0])
     qp = skate_mpc.build_qp(good, max_iter=3)
+    qp.acceptance, qp.rescue = Acceptance(extra_iterations=0), None
     assert qp.time_limit is None
     plan = qp.solve(good)
     assert plan.fallback and plan.iterations == 3 and qp.failures == 1

@@ -21,10 +21,14 @@ class Plan(NamedTuple):
             joint velocities [rad/s], board inputs).
         first_input: :math:`u_0` (nu), what the controller applies until the next solve.
         status: OSQP's status string (``solved``, ``primal infeasible``, ...), or why the QP
-            was not solved (``invalid data``, ``time limit exceeded``).
+            was not solved (``invalid data``, ``time limit exceeded``); ``..., accepted``
+            for an unconverged solve within its residual bounds
+            (:mod:`~ridempc.mpc.plan_acceptance`), ``..., elastic (slack s)`` for one
+            solved in its elastic form (:mod:`~ridempc.mpc.elastic`).
         solve_time: Wall time of writing the new values into the QP and solving it [s].
-        fallback: True when the QP failed and this is the previous plan shifted by one step
-            (or, before any plan succeeded, the reference).
+        fallback: True when the QP gave no plan (neither OSQP nor its elastic form) and this
+            is the previous plan shifted by one step (or, before any plan succeeded, the
+            reference).
         iterations: ADMM iterations (0 when the solver was not run).
     """
 

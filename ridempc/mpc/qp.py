@@ -29,8 +29,14 @@ new values into that pattern (``Px``, ``Ax``, ``l``, ``u`` of OSQP's ``update``)
 OSQP is set up once, each row held in one OSQP class (:mod:`ridempc.mpc.row_classes`, so
 that new bounds never re-factor the KKT matrix), and each solve is warm-started from the
 previous plan shifted by one step (primal and dual). A solve that does not end ``solved``
-within the iteration budget (or an optional wall-clock time limit) returns the previous
-plan shifted by one step, flagged as a fallback, and counts as a failure.
+within the iteration budget continues for a few more iterations and its plan is used
+if it converges then or if its residuals are within the bounds of
+:class:`~ridempc.mpc.plan_acceptance.Acceptance`. A solve that still gives no plan (or
+that OSQP finds infeasible) is solved again in its elastic form by an interior point
+method (:mod:`ridempc.mpc.elastic`: the inequality rows with exact-penalty slacks, always
+feasible, the QP's own solution when the QP is feasible). Only a solve beyond an optional
+wall-clock time limit, or one the rescue too gives no plan, returns the previous plan
+shifted by one step, flagged as a fallback, and counts as a failure.
 """
 
 from __future__ import annotations
@@ -45,7 +51,9 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ridempc.interrupts import osqp_returned
+from ridempc.mpc.elastic import ElasticRescue
 from ridempc.mpc.plan import Plan, shift_plan
+from ridempc.mpc.plan_acceptance import Acceptance
 from ridempc.mpc.problem import MpcProblem
 from ridempc.mpc.row_classes import RowClasses
 
@@ -96,6 +104,14 @@ DEFAULT_SETTINGS: dict[str, Any] = {
     "warm_starting": True,
 }
 _SOLVED = osqp.SolverStatus.OSQP_SOLVED
+# the statuses of a solve that ended its budget unconverged (continued, see Acceptance)
+_UNCONVERGED = (osqp.SolverStatus.OSQP_MAX_ITER_REACHED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE)
+# the statuses of a solve that gave no plan and is solved again in its elastic form
+_RESCUED = (
+    *_UNCONVERGED,
+    osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE,
+    osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE_INACCURATE,
+)
 # OSQP's infinity, to which its Python ``update`` clips the bounds (written here as it does)
 _INFINITY = float(osqp.constant("OSQP_INFTY"))
 _PATTERN_TOLERANCE = 1e-9  # values this small outside the pattern are round-off
@@ -208,16 +224,24 @@ class MpcQP:
             state_scale: Typical size of each state's deviation (nx, default ones).
             input_scale: Typical size of each input's deviation (nu, default ones), e.g.
                 the weight per contact [N] for the forces.
-            settings: OSQP settings over :data:`DEFAULT_SETTINGS`, and ``row_classes``:
+            settings: OSQP settings over :data:`DEFAULT_SETTINGS`, ``row_classes``:
                 True (default) holds each row in one OSQP class
                 (:mod:`~ridempc.mpc.row_classes`: new bounds never re-factor the KKT
-                matrix), False gives each row the class its bounds ask for.
+                matrix), False gives each row the class its bounds ask for, and
+                ``acceptance``: the rule for an unconverged solve
+                (:class:`~ridempc.mpc.plan_acceptance.Acceptance`, default its own; None:
+                no unconverged solve accepted), and ``rescue``: the elastic solve of a QP
+                that gives no plan (:class:`~ridempc.mpc.elastic.ElasticRescue`, default
+                its own; None: none, the solve fails).
         """
         self.horizon, self.nx, self.nu = problem.horizon, problem.nx, problem.nu
         self.n_constraints = problem.n_constraints
         self.structure = structure or QPStructure.of(problem)
         self._check_structure()
         held = bool(settings.pop("row_classes", True))
+        acceptance = settings.pop("acceptance", Acceptance())
+        self.acceptance: Acceptance = Acceptance(0) if acceptance is None else acceptance
+        self.rescue: ElasticRescue | None = settings.pop("rescue", ElasticRescue())
         self.settings = {**DEFAULT_SETTINGS, **settings}
         limit = self.settings.get("time_limit")
         self.time_limit: float | None = None if limit is None else float(limit)
@@ -237,6 +261,8 @@ class MpcQP:
             [np.tile(sx, n + 1), np.tile(su, n), np.ones(n * self.n_constraints)]
         )
         self._input_scale = su
+        first = (n + 1) * self.nx  # u_0 in z
+        self._first_input = slice(first, first + self.nu)
         s = self.structure
         self._outside_at = {
             name: np.flatnonzero(~pattern)
@@ -543,10 +569,39 @@ class MpcQP:
             result = self._run_osqp()
             status, iterations = str(result.info.status), int(result.info.iter)
             ok = result.info.status_val == _SOLVED
+            if not ok and self.acceptance.enabled and result.info.status_val in _UNCONVERGED:
+                result, status, iterations, ok = self._continue(result, iterations)
         except (osqp.OSQPException, ValueError) as exc:
             result, status, iterations, ok = None, f"solver error ({exc!r})", 0, False
         osqp_returned(result.info.status_val if result is not None else _SOLVED)
         return SolveOutcome(result, status, iterations, ok, time.perf_counter() - begin)
+
+    def _continue(self, result: _Result, iterations: int) -> tuple[_Result, str, int, bool]:
+        """An unconverged solve continued from its last iterates for the acceptance's
+        extra iterations (:mod:`~ridempc.mpc.plan_acceptance`): its result, status, total
+        iterations and whether its plan is used (converged, or within the bounds)."""
+        osqp_returned(result.info.status_val)  # an interrupt ends it here
+        before = np.array(result.x[self._first_input], dtype=float)
+        self._solver.update_settings(max_iter=self.acceptance.extra_iterations)
+        try:
+            result = self._run_osqp()  # warm_starting: from the last x, z, y and rho
+        finally:
+            self._solver.update_settings(max_iter=int(self.settings["max_iter"]))
+        iterations += int(result.info.iter)
+        status = str(result.info.status)
+        if result.info.status_val == _SOLVED:
+            return result, status, iterations, True
+        accepted = result.info.status_val in _UNCONVERGED and self.acceptance.accepts(
+            float(result.info.prim_res), before, result.x[self._first_input]
+        )
+        return result, Acceptance.status(status) if accepted else status, iterations, accepted
+
+    def _rescues(self, outcome: SolveOutcome) -> bool:
+        """Whether a solve that gave no plan is solved again in its elastic form: one
+        OSQP ended unconverged or found infeasible (not a deadline, an interrupt or a
+        solver error)."""
+        result = outcome.result
+        return self.rescue is not None and result is not None and result.info.status_val in _RESCUED
 
     def _run_osqp(self) -> _Result:
         """OSQP's solve on the extension's solver: its solution and info as OSQP's Python
@@ -566,12 +621,19 @@ class MpcQP:
         if ok and self.time_limit is not None and elapsed > self.time_limit:
             status, ok = f"time limit exceeded ({elapsed * 1e3:.1f} ms)", False
         problem, result = started.problem, outcome.result
+        scaled = np.asarray(result.x, dtype=float) if ok else None
         if ok:
-            z = started.reference + self._scale * np.asarray(result.x, dtype=float)
+            self._previous_dual = np.asarray(result.y, dtype=float).copy()
+        elif self._rescues(outcome):
+            assert self.rescue is not None
+            rescued = self.rescue.solve(*self.matrices(problem), *self.bounds(problem))
+            if rescued.z is not None:  # the previous dual kept for the next warm start
+                scaled, status = rescued.z, f"{status}, elastic (slack {rescued.slack:.2g})"
+        if scaled is not None:
+            z = started.reference + self._scale * scaled
             states, inputs = self._unpack(z)
             elapsed += time.perf_counter() - begin
             plan = Plan(states, inputs, inputs[0].copy(), status, elapsed, False, iterations)
-            self._previous_dual = np.asarray(result.y, dtype=float).copy()
         else:
             self.failures += 1
             elapsed += time.perf_counter() - begin
