@@ -25,6 +25,7 @@ from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
 from ridempc.wbc.targets import WbcTargets
+from ridempc.wheel_grip import WHEEL_GRIP
 
 __all__ = [
     "ClosedChainConstraint",
@@ -37,6 +38,7 @@ __all__ = [
     "RigidSpringConstraint",
     "TorqueLimitConstraint",
     "TorqueSpeedConstraint",
+    "WheelGripConstraint",
 ]
 
 Array = NDArray[np.float64]
@@ -400,14 +402,45 @@ class PlatformTipConstraint(Constraint):
         tipping = contacts.tipping[: self.rows // 2]
         if tipping:
             sites, plus, minus = self._indices(tuple(t[0] for t in tipping))
-            offsets = np.concatenate([t[1] for t in tipping])[:, None]
-            ratio = np.concatenate([t[2] for t in tipping])[:, None]
+            offsets, ratio = self._ratios(tipping)
             axes = contacts.frame[sites]
             side, normal = axes[:, 1], axes[:, 2]
             block.matrix.put(plus, (offsets - ratio) * normal - side)
             block.matrix.put(minus, (-offsets - ratio) * normal + side)
         block.lower[:] = self._lower
         block.upper[:] = self._upper
+
+    def _ratios(self, tipping: tuple[tuple[Index, Array, Array], ...]) -> tuple[Array, Array]:
+        """Each site's :math:`y_s / h` and :math:`w / 2h` [-], as columns."""
+        offsets = np.concatenate([t[1] for t in tipping])[:, None]
+        ratio = np.concatenate([t[2] for t in tipping])[:, None]
+        return offsets, ratio
+
+
+class WheelGripConstraint(PlatformTipConstraint):
+    """A platform on one wheel does not skid sideways (:mod:`ridempc.wheel_grip`): per
+    platform that tips (the same platforms and sites as :class:`PlatformTipConstraint`), two
+    rows
+
+    .. math:: \\sum_s (\\pm t_2 - \\mu_g\\, n)^\\top f_s \\le 0,
+
+    the tipping rows with the sites on the axis and :math:`\\mu_g` for :math:`w/2h`. On a
+    floor of the conservative :math:`\\mu_g = 0.2` it bounds the feet's net sideways force
+    below the tread's 0.41 whenever a foot stands less than 2.3 cm off the shoe's axis.
+
+    Args:
+        layout: The decision vector's layout.
+        platforms: How many platforms tip (rows for each).
+        grip: :math:`\\mu_g` [-], the wheel's sideways grip on the floor.
+    """
+
+    def __init__(self, layout: DecisionLayout, platforms: int, grip: float = WHEEL_GRIP) -> None:
+        super().__init__(layout, platforms)
+        self.grip = grip
+
+    def _ratios(self, tipping: tuple[tuple[Index, Array, Array], ...]) -> tuple[Array, Array]:
+        sites = sum(len(t[0]) for t in tipping)
+        return np.zeros((sites, 1)), np.full((sites, 1), self.grip)
 
 
 class TorqueLimitConstraint(Constraint):
