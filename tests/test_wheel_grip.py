@@ -1,5 +1,5 @@
-"""A Hovershoe's wheel does not skid sideways: the whole-body QP's grip rows (the MPC's, which
-share its tipping rows: tests/test_tipping.py).
+"""A Hovershoe's wheel neither skids sideways nor spins: the whole-body QP's grip rows (the
+MPC's sideways rows share its tipping rows: tests/test_tipping.py).
 
 The feet's net sideways force on a shoe stays within the conservative floor grip
 :math:`\\mu_g` of their load, whatever the feet's offsets across the shoe (which only the
@@ -9,6 +9,8 @@ takes none of it. The riding library's own plans stay inside it.
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -17,19 +19,28 @@ from ridempc.paths import motion_library_dir
 from ridempc.wbc.constraints import WheelGripConstraint
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
+from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wheel_grip import WHEEL_GRIP
 
 TIP = 0.045 / 0.11  # half the shoe's tread over its deck's height
 LOAD = 100.0  # [N] per site
 
 
-def _wbc_rows(offsets: np.ndarray, grip: float = WHEEL_GRIP):
+SHOE = RollingPlatform(mass=2.7, drive=447.3, tread=0.09, height=0.11, twist_damping=18.2)
+# two sites 8 cm apart along a line foot on the shoe's axis (x forward, y to the left)
+PLACES = np.array([[0.04, 0.0, 0.11], [-0.04, 0.0, 0.11]])
+
+
+def _wbc_rows(offsets: np.ndarray, grip: float = WHEEL_GRIP, turn: float = 0.0):
     layout = DecisionLayout(nv=6, n_sites=2, n_motors=0)
     contacts = ContactSet.on_ground(np.array([True, True]))
     tipping = ((np.array([0, 1]), offsets, np.full(2, TIP)),)
     contacts = ContactSet(contacts.active, contacts.frame, contacts.acceleration, None, tipping)
-    block = WheelGripConstraint(layout, 1, grip).compute_qp_constraint(None, None, contacts)
-    assert block.matrix.shape == (2, layout.size)
+    terms = SimpleNamespace(sites=SimpleNamespace(position=PLACES))
+    targets = SimpleNamespace(angular_velocity=np.array([0.0, 0.0, turn]))
+    constraint = WheelGripConstraint(layout, [SHOE, None], grip)
+    block = constraint.compute_qp_constraint(terms, targets, contacts)
+    assert block.matrix.shape == (4, layout.size)
     assert np.all(block.lower == -np.inf)
 
     def holds(forces) -> bool:
@@ -51,11 +62,33 @@ def test_the_wbc_keeps_the_net_sideways_force_within_the_grip(side: float, offse
     within, beyond = side * 0.99 * WHEEL_GRIP * LOAD, side * 1.01 * WHEEL_GRIP * LOAD
     assert holds([[0, within, LOAD], [0, within, LOAD]])
     assert not holds([[0, beyond, LOAD], [0, beyond, LOAD]])
-    twist = 0.9 * LOAD  # opposite ends of a line foot: no net sideways force
-    assert holds([[0, twist, LOAD], [0, -twist, LOAD]])
     assert holds([[0.5 * LOAD, 0, LOAD]] * 2)  # along the travel the wheel rolls
     # the shoes squeezed apart: each foot pushing its shoe outwards at 0.3 of its load
     assert not holds([[0, 0.3 * LOAD, LOAD]] * 2)
+
+
+def _twist(torque: float) -> list[list[float]]:
+    """Opposite sideways forces at the foot's two ends: a twist of ``torque`` [N m] on the
+    shoe, no net sideways force."""
+    side = torque / 0.08
+    return [[0, -side, LOAD], [0, side, LOAD]]
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_the_wbc_twists_a_standing_shoe_no_harder_than_its_rims_hold(sign: float) -> None:
+    rims = WHEEL_GRIP * 2 * LOAD * 0.045  # mu_g N w / 2 [N m]
+    holds = _wbc_rows(np.zeros(2))
+    assert holds(_twist(sign * 0.99 * rims))
+    assert not holds(_twist(sign * 1.01 * rims))
+
+
+def test_a_planned_turn_twists_as_hard_as_its_rims_slide() -> None:
+    """At 0.5 rad/s the rims' damping takes 9.1 N m, which the turn may add."""
+    rims = WHEEL_GRIP * 2 * LOAD * 0.045
+    turning = _wbc_rows(np.zeros(2), turn=-0.5)
+    assert turning(_twist(rims + 0.99 * 18.2 * 0.5))
+    assert not turning(_twist(rims + 1.01 * 18.2 * 0.5))
+    assert not turning([[0, 0.3 * LOAD, LOAD]] * 2)  # the sideways grip stays
 
 
 def test_a_grippier_floor_allows_more() -> None:

@@ -14,6 +14,7 @@ as a :class:`LinearConstraint`. An inequality
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -24,6 +25,7 @@ from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
+from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.targets import WbcTargets
 from ridempc.wheel_grip import WHEEL_GRIP
 
@@ -44,6 +46,7 @@ __all__ = [
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 INF: float = np.inf
+_XYZ = np.arange(3)
 
 
 class LinearConstraint(NamedTuple):
@@ -402,7 +405,8 @@ class PlatformTipConstraint(Constraint):
         tipping = contacts.tipping[: self.rows // 2]
         if tipping:
             sites, plus, minus = self._indices(tuple(t[0] for t in tipping))
-            offsets, ratio = self._ratios(tipping)
+            offsets = np.concatenate([t[1] for t in tipping])[:, None]
+            ratio = np.concatenate([t[2] for t in tipping])[:, None]
             axes = contacts.frame[sites]
             side, normal = axes[:, 1], axes[:, 2]
             block.matrix.put(plus, (offsets - ratio) * normal - side)
@@ -410,37 +414,69 @@ class PlatformTipConstraint(Constraint):
         block.lower[:] = self._lower
         block.upper[:] = self._upper
 
-    def _ratios(self, tipping: tuple[tuple[Index, Array, Array], ...]) -> tuple[Array, Array]:
-        """Each site's :math:`y_s / h` and :math:`w / 2h` [-], as columns."""
-        offsets = np.concatenate([t[1] for t in tipping])[:, None]
-        ratio = np.concatenate([t[2] for t in tipping])[:, None]
-        return offsets, ratio
 
+class WheelGripConstraint(Constraint):
+    """A platform on one wheel neither skids sideways nor spins on the floor
+    (:mod:`ridempc.wheel_grip`): per platform that tips (the platforms and sites of
+    :class:`PlatformTipConstraint`, with the forces :math:`f_s` on the robot at its sites
+    :math:`p_s`, the platform's sideways axis :math:`t_2` and normal :math:`n`), four rows
 
-class WheelGripConstraint(PlatformTipConstraint):
-    """A platform on one wheel does not skid sideways (:mod:`ridempc.wheel_grip`): per
-    platform that tips (the same platforms and sites as :class:`PlatformTipConstraint`), two
-    rows
+    .. math::
 
-    .. math:: \\sum_s (\\pm t_2 - \\mu_g\\, n)^\\top f_s \\le 0,
+        \\pm \\sum_s t_2^\\top f_s - \\mu_g \\sum_s n^\\top f_s \\le 0, \\qquad
+        \\pm \\frac{2}{w} M - \\mu_g \\sum_s n^\\top f_s \\le \\frac{2}{w} c_3 |\\omega_z|,
+        \\qquad M = -\\sum_s f_s^\\top \\big(n \\times (p_s - \\bar p)\\big):
 
-    the tipping rows with the sites on the axis and :math:`\\mu_g` for :math:`w/2h`. On a
-    floor of the conservative :math:`\\mu_g = 0.2` it bounds the feet's net sideways force
-    below the tread's 0.41 whenever a foot stands less than 2.3 cm off the shoe's axis.
+    the feet's net sideways force within :math:`\\mu_g` of their load, and their twist
+    :math:`M` [N m] on the shoe (about its feet's centroid :math:`\\bar p`, where the
+    estimate puts the platform) within what the tyre's two rims, :math:`w/2` either side of
+    its middle, hold by friction, :math:`\\mu_g N w / 2`, plus what the planned turn
+    needs: eq. (5)'s rim damping :math:`c_3` at the rider's planned yaw rate
+    :math:`\\omega_z` (on a grippier floor a turn slides the rims against more than
+    :math:`\\mu_g`). Beyond it the rims slip and the shoe spins: eq. (5)'s linear damping,
+    identified on a floor of friction 1, holds 3-5 times the torque the rims of a 0.2-0.3
+    floor do, so plans built on it drive the shoes' yaw round at 3-4 Hz. Each row gives
+    the whole grip to one of the two (a box, not the rims' shared cone); the foot's own
+    offset along the shoe (the shoe observer's :math:`d`, a few cm) is left out of :math:`M`.
 
     Args:
         layout: The decision vector's layout.
-        platforms: How many platforms tip (rows for each).
-        grip: :math:`\\mu_g` [-], the wheel's sideways grip on the floor.
+        platforms: The board's rolling platforms; those with a tread get rows, in order.
+        grip: :math:`\\mu_g` [-], the wheel's grip on the floor.
     """
 
-    def __init__(self, layout: DecisionLayout, platforms: int, grip: float = WHEEL_GRIP) -> None:
-        super().__init__(layout, platforms)
-        self.grip = grip
+    soft = True  # the floor's grip models the board; not a limit of the robot
 
-    def _ratios(self, tipping: tuple[tuple[Index, Array, Array], ...]) -> tuple[Array, Array]:
-        sites = sum(len(t[0]) for t in tipping)
-        return np.zeros((sites, 1)), np.full((sites, 1), self.grip)
+    def __init__(
+        self,
+        layout: DecisionLayout,
+        platforms: Sequence[RollingPlatform | None],
+        grip: float = WHEEL_GRIP,
+    ) -> None:
+        super().__init__(layout)
+        self.grip = grip
+        wheels = [p for p in platforms if p is not None and p.tread is not None]
+        self._twist = [2.0 / p.tread for p in wheels if p.tread is not None]  # 2 / w [1/m]
+        self._damping = [p.twist_damping for p in wheels]  # c_3 [N m s/rad]
+        self.rows = 4 * len(wheels)
+        self._lower = np.full(self.rows, -INF)
+
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        block.lower[:] = self._lower
+        block.upper[:] = 0.0
+        turn = abs(float(targets.angular_velocity[2])) if targets is not None else 0.0
+        start = self.layout.force.start
+        for j, (sites, _, _) in enumerate(contacts.tipping[: self.rows // 4]):
+            axes = contacts.frame[sites]
+            side, load = axes[:, 1], self.grip * axes[:, 2]
+            place = terms.sites.position[sites] if terms is not None else np.zeros((len(sites), 3))
+            twist = -self._twist[j] * np.cross(axes[:, 2], place - place.mean(axis=0))
+            columns = start + 3 * sites[:, None] + _XYZ  # (sites, 3)
+            for k, row in enumerate((side, -side, twist, -twist)):
+                block.matrix[4 * j + k, columns] = row - load
+            block.upper[4 * j + 2 : 4 * j + 4] = self._twist[j] * self._damping[j] * turn
 
 
 class TorqueLimitConstraint(Constraint):

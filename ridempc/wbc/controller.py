@@ -186,7 +186,7 @@ class WholeBodyController:
             ),
             TorqueSpeedConstraint(layout, TorqueSpeedCurve.of(self.robot.motors), self.motor_v),
             PlatformTipConstraint(layout, self._tipping),
-            WheelGripConstraint(layout, self._tipping),
+            WheelGripConstraint(layout, self.platforms),
         ]
 
     def _probe_problems(self, stand: Array) -> list[QpProblem]:
