@@ -456,27 +456,57 @@ class WheelGripConstraint(Constraint):
         super().__init__(layout)
         self.grip = grip
         wheels = [p for p in platforms if p is not None and p.tread is not None]
-        self._twist = [2.0 / p.tread for p in wheels if p.tread is not None]  # 2 / w [1/m]
-        self._damping = [p.twist_damping for p in wheels]  # c_3 [N m s/rad]
+        self._twist = np.array([2.0 / p.tread for p in wheels if p.tread is not None])  # [1/m]
+        self._allowance = self._twist * [p.twist_damping for p in wheels]  # 2 c_3 / w [N s]
         self.rows = 4 * len(wheels)
         self._lower = np.full(self.rows, -INF)
+        self._upper = np.zeros(self.rows)
+        self._entries: dict[tuple[bytes, ...], tuple[Index, Array, Array, Index]] = {}
+
+    def _indices(self, sites: tuple[Index, ...]) -> tuple[Index, Array, Array, Index]:
+        """The platforms' sites in a row, each site's 2 / w, the matrix averaging each
+        platform's sites, and the flat indices (in the block's own matrix) of the four rows'
+        entries per site and force component; a few distinct lists per ride."""
+        key = tuple(s.tobytes() for s in sites)
+        cached = self._entries.get(key)
+        if cached is None:
+            stacked = np.concatenate(sites)
+            platform = np.repeat(np.arange(len(sites)), [len(s) for s in sites])
+            same = platform[:, None] == platform[None, :]
+            mean = same / same.sum(axis=1, keepdims=True)
+            columns = self.layout.force.start + 3 * stacked[:, None] + _XYZ  # (sites, 3)
+            rows = 4 * platform[:, None] + np.arange(4)  # (sites, 4)
+            flat = rows[:, :, None] * self.layout.size + columns[:, None, :]  # (sites, 4, 3)
+            cached = (stacked, self._twist[platform][:, None], mean, flat.ravel())
+            self._entries[key] = cached
+        return cached
 
     def fill_qp_constraint(
         self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
     ) -> None:
         block.lower[:] = self._lower
-        block.upper[:] = 0.0
-        turn = abs(float(targets.angular_velocity[2])) if targets is not None else 0.0
-        start = self.layout.force.start
-        for j, (sites, _, _) in enumerate(contacts.tipping[: self.rows // 4]):
-            axes = contacts.frame[sites]
-            side, load = axes[:, 1], self.grip * axes[:, 2]
-            place = terms.sites.position[sites] if terms is not None else np.zeros((len(sites), 3))
-            twist = -self._twist[j] * np.cross(axes[:, 2], place - place.mean(axis=0))
-            columns = start + 3 * sites[:, None] + _XYZ  # (sites, 3)
-            for k, row in enumerate((side, -side, twist, -twist)):
-                block.matrix[4 * j + k, columns] = row - load
-            block.upper[4 * j + 2 : 4 * j + 4] = self._twist[j] * self._damping[j] * turn
+        block.upper[:] = self._upper
+        wheels = contacts.tipping[: self.rows // 4]
+        if not wheels:
+            return
+        sites, twist, mean, flat = self._indices(tuple(t[0] for t in wheels))
+        axes = contacts.frame[sites]
+        side, normal = axes[:, 1], axes[:, 2]
+        place = terms.sites.position[sites]
+        lever = place - mean @ place  # from the feet's centroid on each shoe
+        # M's coefficients, -(2/w) n x l, per site
+        moment = twist * np.stack(
+            [
+                normal[:, 2] * lever[:, 1] - normal[:, 1] * lever[:, 2],
+                normal[:, 0] * lever[:, 2] - normal[:, 2] * lever[:, 0],
+                normal[:, 1] * lever[:, 0] - normal[:, 0] * lever[:, 1],
+            ],
+            axis=1,
+        )
+        load = self.grip * normal
+        block.matrix.put(flat, np.stack([side, -side, moment, -moment], axis=1) - load[:, None])
+        turn = abs(float(targets.angular_velocity[2]))
+        block.upper[2 : self.rows : 4] = block.upper[3 : self.rows : 4] = self._allowance * turn
 
 
 class TorqueLimitConstraint(Constraint):
