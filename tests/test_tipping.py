@@ -19,6 +19,7 @@ from ridempc.wbc.constraints import PlatformTipConstraint
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.platforms import RollingPlatform
+from ridempc.wheel_grip import WHEEL_GRIP
 
 RATIO = 0.045 / 0.11  # half the shoe's tread over its deck's height
 
@@ -71,12 +72,14 @@ def test_the_wbc_keeps_the_net_sideways_force_within_the_tread(side: float) -> N
     assert _holds(off, upper, layout, [[0, 1.1 * limit, load]] * 2)
 
 
-def test_the_mpc_keeps_the_net_sideways_force_within_the_tread() -> None:
+def mpc_sideways_rows(yaw: float, grip: float | None = None):
+    """The MPC's rows on one shoe turned by ``yaw`` [rad] (two contacts), its pattern's
+    check, and a test of forces in the shoe's frame against its two sideways rows."""
     index = np.arange(6).reshape(2, 3)
     tipping = (((0, 1), RATIO),)
-    yaw = 0.3  # a turned platform: its sideways axis in the world
     c, s = np.cos(yaw), np.sin(yaw)
     rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    kwargs = {} if grip is None else {"grip": grip}
     matrix, lower, upper = friction_pyramids(
         index,
         6,
@@ -86,6 +89,7 @@ def test_the_mpc_keeps_the_net_sideways_force_within_the_tread() -> None:
         500.0,
         shape="diamond",
         tipping=tipping,
+        **kwargs,
     )
     assert matrix.shape == (1, 12, 6)
     pattern = pyramid_pattern(index, 6, tipping)
@@ -97,7 +101,23 @@ def test_the_mpc_keeps_the_net_sideways_force_within_the_tread() -> None:
         g = matrix[0, rows] @ world
         return bool(np.all(g <= upper[0, rows] + 1e-9) and np.all(g >= lower[0, rows]))
 
+    return holds
+
+
+def test_the_mpc_keeps_the_net_sideways_force_within_the_tread() -> None:
+    # a turned platform, on a floor that grips beyond the tread: the tread alone
+    holds = mpc_sideways_rows(0.3, grip=1.0)
     load = 100.0
     assert holds([[0.0, 0.99 * RATIO * load, load]] * 2)
     assert not holds([[0.0, -1.01 * RATIO * load, load]] * 2)
     assert holds([[0.0, 0.5 * load, load], [0.0, -0.5 * load, load]])  # a twist
+
+
+def test_the_mpc_keeps_the_net_sideways_force_within_the_wheels_grip() -> None:
+    """The default grip (:mod:`ridempc.wheel_grip`) is tighter than the tread: it gives
+    first, on the same rows; a twist takes none of it."""
+    holds = mpc_sideways_rows(-0.4)
+    load = 100.0
+    assert holds([[0.0, 0.99 * WHEEL_GRIP * load, load]] * 2)
+    assert not holds([[0.0, -1.01 * WHEEL_GRIP * load, load]] * 2)
+    assert holds([[0.0, 0.5 * load, load], [0.0, -0.5 * load, load]])

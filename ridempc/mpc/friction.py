@@ -25,7 +25,10 @@ platform and step,
 .. math:: \\sum_{i \\in P} (\\pm t_{2,i} - k\\, n_i)^\\top f_i \\le 0, \\qquad k = w / 2h
 
 (tread :math:`w`, deck height :math:`h`; the feet on the platform's axis, its own weight left
-out: :class:`~ridempc.wbc.constraints.PlatformTipConstraint` for the whole-body QP's).
+out: :class:`~ridempc.wbc.constraints.PlatformTipConstraint` for the whole-body QP's). Nor may
+its wheel skid sideways on the floor (:mod:`ridempc.wheel_grip`): the same net sideways force
+within :math:`\\mu_g` of the load, rows of the same form, so the two rows carry the lesser
+ratio, :math:`k = \\min(w / 2h, \\mu_g)`.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from numpy.typing import NDArray
 
 from ridempc.friction import pyramid_matrix
 from ridempc.trajopt.schedule import Contact
+from ridempc.wheel_grip import WHEEL_GRIP
 
 __all__ = ["ROWS_PER_CONTACT", "force_bounds", "friction_pyramids", "pyramid_pattern"]
 
@@ -69,6 +73,7 @@ def friction_pyramids(
     min_force: float = 0.0,
     shape: str = "box",
     tipping: Tipping = (),
+    grip: float = WHEEL_GRIP,
 ) -> tuple[Array, Array, Array]:
     """Friction pyramids of every step (see the module docstring).
 
@@ -83,6 +88,7 @@ def friction_pyramids(
         min_force: :math:`f_{min}` [N] of a contact on a board.
         shape: The pyramid's shape (:func:`ridempc.friction.pyramid_rows`).
         tipping: Per platform that tips, its contacts and :math:`k = w / 2h` [-].
+        grip: :math:`\\mu_g` [-], the sideways grip of a tipping platform's wheel on the floor.
 
     Returns:
         :math:`G` (N x m x nu), :math:`g^{lo}`, :math:`g^{hi}` (N x m), m = 5 n_c plus two
@@ -106,8 +112,9 @@ def friction_pyramids(
         matrix[:, block, force_index[i]] = rows_i
         lower[:, block.start] = np.where(on_board[:, i], min_force, 0.0)
         upper[:, block.start] = np.where(standing[:, i], max_force, 0.0)
-    for j, (contacts, ratio) in enumerate(tipping):
+    for j, (contacts, tip) in enumerate(tipping):
         row = ROWS_PER_CONTACT * nc + 2 * j
+        ratio = min(tip, grip)  # whichever gives first: the tread's edge or the wheel's grip
         for i in contacts:
             rotation = np.asarray(surfaces[i])  # world from surface: columns t1, t2, n
             side, normal = rotation[:, 1], rotation[:, 2]

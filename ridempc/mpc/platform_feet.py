@@ -40,5 +40,6 @@ def rolling_platforms(board: Board | None) -> tuple[RollingPlatform, ...]:
         drive=shoes.reduced.c4,
         tread=params.wheel_width,
         height=params.platform_height,
+        twist_damping=shoes.reduced.c3,
     )
     return (shoe,) * shoes.n_platforms

@@ -14,6 +14,7 @@ as a :class:`LinearConstraint`. An inequality
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -24,7 +25,9 @@ from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.wbc.contacts import ContactSet
 from ridempc.wbc.layout import DecisionLayout
 from ridempc.wbc.model import ModelTerms
+from ridempc.wbc.platforms import RollingPlatform
 from ridempc.wbc.targets import WbcTargets
+from ridempc.wheel_grip import WHEEL_GRIP
 
 __all__ = [
     "ClosedChainConstraint",
@@ -37,11 +40,13 @@ __all__ = [
     "RigidSpringConstraint",
     "TorqueLimitConstraint",
     "TorqueSpeedConstraint",
+    "WheelGripConstraint",
 ]
 
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 INF: float = np.inf
+_XYZ = np.arange(3)
 
 
 class LinearConstraint(NamedTuple):
@@ -408,6 +413,100 @@ class PlatformTipConstraint(Constraint):
             block.matrix.put(minus, (-offsets - ratio) * normal + side)
         block.lower[:] = self._lower
         block.upper[:] = self._upper
+
+
+class WheelGripConstraint(Constraint):
+    """A platform on one wheel neither skids sideways nor spins on the floor
+    (:mod:`ridempc.wheel_grip`): per platform that tips (the platforms and sites of
+    :class:`PlatformTipConstraint`, with the forces :math:`f_s` on the robot at its sites
+    :math:`p_s`, the platform's sideways axis :math:`t_2` and normal :math:`n`), four rows
+
+    .. math::
+
+        \\pm \\sum_s t_2^\\top f_s - \\mu_g \\sum_s n^\\top f_s \\le 0, \\qquad
+        \\pm \\frac{2}{w} M - \\mu_g \\sum_s n^\\top f_s \\le \\frac{2}{w} c_3 |\\omega_z|,
+        \\qquad M = -\\sum_s f_s^\\top \\big(n \\times (p_s - \\bar p)\\big):
+
+    the feet's net sideways force within :math:`\\mu_g` of their load, and their twist
+    :math:`M` [N m] on the shoe (about its feet's centroid :math:`\\bar p`, where the
+    estimate puts the platform) within what the tyre's two rims, :math:`w/2` either side of
+    its middle, hold by friction, :math:`\\mu_g N w / 2`, plus what the planned turn
+    needs: eq. (5)'s rim damping :math:`c_3` at the rider's planned yaw rate
+    :math:`\\omega_z` (on a grippier floor a turn slides the rims against more than
+    :math:`\\mu_g`). Beyond it the rims slip and the shoe spins: eq. (5)'s linear damping,
+    identified on a floor of friction 1, holds 3-5 times the torque the rims of a 0.2-0.3
+    floor do, so plans built on it drive the shoes' yaw round at 3-4 Hz. Each row gives
+    the whole grip to one of the two (a box, not the rims' shared cone); the foot's own
+    offset along the shoe (the shoe observer's :math:`d`, a few cm) is left out of :math:`M`.
+
+    Args:
+        layout: The decision vector's layout.
+        platforms: The board's rolling platforms; those with a tread get rows, in order.
+        grip: :math:`\\mu_g` [-], the wheel's grip on the floor.
+    """
+
+    soft = True  # the floor's grip models the board; not a limit of the robot
+
+    def __init__(
+        self,
+        layout: DecisionLayout,
+        platforms: Sequence[RollingPlatform | None],
+        grip: float = WHEEL_GRIP,
+    ) -> None:
+        super().__init__(layout)
+        self.grip = grip
+        wheels = [p for p in platforms if p is not None and p.tread is not None]
+        self._twist = np.array([2.0 / p.tread for p in wheels if p.tread is not None])  # [1/m]
+        self._allowance = self._twist * [p.twist_damping for p in wheels]  # 2 c_3 / w [N s]
+        self.rows = 4 * len(wheels)
+        self._lower = np.full(self.rows, -INF)
+        self._upper = np.zeros(self.rows)
+        self._entries: dict[tuple[bytes, ...], tuple[Index, Array, Array, Index]] = {}
+
+    def _indices(self, sites: tuple[Index, ...]) -> tuple[Index, Array, Array, Index]:
+        """The platforms' sites in a row, each site's 2 / w, the matrix averaging each
+        platform's sites, and the flat indices (in the block's own matrix) of the four rows'
+        entries per site and force component; a few distinct lists per ride."""
+        key = tuple(s.tobytes() for s in sites)
+        cached = self._entries.get(key)
+        if cached is None:
+            stacked = np.concatenate(sites)
+            platform = np.repeat(np.arange(len(sites)), [len(s) for s in sites])
+            same = platform[:, None] == platform[None, :]
+            mean = same / same.sum(axis=1, keepdims=True)
+            columns = self.layout.force.start + 3 * stacked[:, None] + _XYZ  # (sites, 3)
+            rows = 4 * platform[:, None] + np.arange(4)  # (sites, 4)
+            flat = rows[:, :, None] * self.layout.size + columns[:, None, :]  # (sites, 4, 3)
+            cached = (stacked, self._twist[platform][:, None], mean, flat.ravel())
+            self._entries[key] = cached
+        return cached
+
+    def fill_qp_constraint(
+        self, block: LinearConstraint, terms: ModelTerms, targets: WbcTargets, contacts: ContactSet
+    ) -> None:
+        block.lower[:] = self._lower
+        block.upper[:] = self._upper
+        wheels = contacts.tipping[: self.rows // 4]
+        if not wheels:
+            return
+        sites, twist, mean, flat = self._indices(tuple(t[0] for t in wheels))
+        axes = contacts.frame[sites]
+        side, normal = axes[:, 1], axes[:, 2]
+        place = terms.sites.position[sites]
+        lever = place - mean @ place  # from the feet's centroid on each shoe
+        # M's coefficients, -(2/w) n x l, per site
+        moment = twist * np.stack(
+            [
+                normal[:, 2] * lever[:, 1] - normal[:, 1] * lever[:, 2],
+                normal[:, 0] * lever[:, 2] - normal[:, 2] * lever[:, 0],
+                normal[:, 1] * lever[:, 0] - normal[:, 0] * lever[:, 1],
+            ],
+            axis=1,
+        )
+        load = self.grip * normal
+        block.matrix.put(flat, np.stack([side, -side, moment, -moment], axis=1) - load[:, None])
+        turn = abs(float(targets.angular_velocity[2]))
+        block.upper[2 : self.rows : 4] = block.upper[3 : self.rows : 4] = self._allowance * turn
 
 
 class TorqueLimitConstraint(Constraint):

@@ -46,6 +46,7 @@ from ridempc.wbc.constraints import (
     PlatformTipConstraint,
     RigidSpringConstraint,
     TorqueSpeedConstraint,
+    WheelGripConstraint,
 )
 from ridempc.wbc.contacts import ContactSet, build_contact_set
 from ridempc.wbc.in_flight import TorquesInFlight
@@ -185,6 +186,7 @@ class WholeBodyController:
             ),
             TorqueSpeedConstraint(layout, TorqueSpeedCurve.of(self.robot.motors), self.motor_v),
             PlatformTipConstraint(layout, self._tipping),
+            WheelGripConstraint(layout, self.platforms),
         ]
 
     def _probe_problems(self, stand: Array) -> list[QpProblem]:

@@ -69,12 +69,16 @@ class RollingPlatform:
             tips sideways (None: it does not tip; :class:`~ridempc.wbc.constraints.
             PlatformTipConstraint`).
         height: Height of the deck's top, where the feet stand, over the ground [m].
+        twist_damping: :math:`c_3` [N m s/rad], the yaw torque per yaw rate its wheel's rims
+            take sliding round on the floor (eq. (5); :class:`~ridempc.wbc.constraints.
+            WheelGripConstraint`).
     """
 
     mass: float
     drive: float
     tread: float | None = None
     height: float = 0.0
+    twist_damping: float = 0.0
 
     def __post_init__(self) -> None:
         if not (self.mass > 0.0 and math.isfinite(self.drive)):
