@@ -119,11 +119,13 @@ RETURN_DWELL_S: float = 0.5
 # model met again, so the backup, which needs no model, keeps the ride.
 RETURNS: int = 1
 # [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
-# beyond which its linear model no longer holds and the ride is handed over: 1.7 times the
-# largest the MPC reached in the library's manoeuvres (1.40-1.75: Segway push and
-# velocity-steps, Hovershoes velocity-steps, skateboard push-off-0.5, seed 0).
-HANDOVER_DEVIATION: float = 3.0
-# [-] the same error below which the primary may ride again: a third of the handover's,
+# beyond which the ride is handed over: within the backup's basin, not at the edge of the
+# primary's model. 1.25 times the largest the MPC reached in the library's manoeuvres
+# (1.40-1.75: Segway push and velocity-steps, Hovershoes velocity-steps, skateboard
+# push-off-0.5), so those ride on without one; at 3.0 the handed PD was past its basin (on
+# 100 `hard` variants of each of Cassie's boards it saved 4 of the 18 rides handed over there).
+HANDOVER_DEVIATION: float = 2.2
+# [-] the same error below which the primary may ride again: under half the handover's,
 # the band between them the hysteresis (standing still on the Hovershoes it sits at
 # 0.55-0.67 once settled).
 RETURN_DEVIATION: float = 1.0
