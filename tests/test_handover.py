@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ridempc.mpc.divergence import DivergentDeviation
 from ridempc.mpc.handover import (
     BLEND_S,
     POSTURE_FADE_S,
@@ -19,6 +20,8 @@ from ridempc.mpc.handover import (
     standby_every,
     start_window,
 )
+from ridempc.mpc.plan import Plan
+from ridempc.mpc.stages.triggers import HandoverCheck, deviated
 from ridempc.sim.motors import MotorCommand
 
 DT = 0.002  # [s] the rider's tick
@@ -260,3 +263,15 @@ def test_the_start_window_needs_a_height_and_a_start_on_the_primary() -> None:
     assert handover.fade_for(0.1, 0.8) == POSTURE_FADE_S  # its posture at takeover: the backup's
     handover.starting, handover.takeover_s = False, 0.05
     assert handover.fade_for(0.1, 0.8) == POSTURE_FADE_S
+
+
+def test_the_deviation_hands_over_inside_the_backups_basin() -> None:
+    zeros = np.zeros((2, 1))
+    plan = Plan(zeros, zeros[:1], np.zeros(1), "solved", 0.0, False)
+
+    def at(level: float) -> str | None:
+        return deviated(HandoverCheck(plan, 0.0, level, False, True, DivergentDeviation()))
+
+    assert at(1.75) is None  # the library's largest: its manoeuvres ride on
+    assert at(1.25 * 1.75) is None
+    assert at(2.9) is not None  # at 3.0 the handed PD stood in 4 rides of 18: before that
