@@ -84,6 +84,7 @@ from ridempc.sim.sensors import SensorPacket
 __all__ = [
     "BLEND_S",
     "HANDOVER_DEVIATION",
+    "LEAD_DEVIATION",
     "RETURN_DEVIATION",
     "RETURN_DWELL_S",
     "RETURNS",
@@ -125,6 +126,12 @@ RETURNS: int = 1
 # push-off-0.5), so those ride on without one; at 3.0 the handed PD was past its basin (on
 # 100 `hard` variants of each of Cassie's boards it saved 4 of the 18 rides handed over there).
 HANDOVER_DEVIATION: float = 2.2
+# [-] the same bound for the deviation's divergent lead while the primary is on probation
+# (:mod:`~ridempc.mpc.divergence`): a forecast a divergence time ahead, which a start's
+# transient the MPC rides reaches (2.97 on the Segway's velocity-steps, seed 0), and a
+# handover by it finds the backup within its basin (the handed PD stood in 42 of 57 such
+# rides); 1.7 times the library's largest deviation.
+LEAD_DEVIATION: float = 3.0
 # [-] the same error below which the primary may ride again: under half the handover's,
 # the band between them the hysteresis (standing still on the Hovershoes it sits at
 # 0.55-0.67 once settled).
