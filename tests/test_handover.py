@@ -3,12 +3,14 @@ a stand-in backup and made-up commands, ticked at 500 Hz."""
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
 
+from ridempc.mpc.divergence import DivergentDeviation
 from ridempc.mpc.handover import (
     BLEND_S,
     POSTURE_FADE_S,
@@ -16,7 +18,10 @@ from ridempc.mpc.handover import (
     blend,
     deviation,
     standby_every,
+    start_window,
 )
+from ridempc.mpc.plan import Plan
+from ridempc.mpc.stages.triggers import HandoverCheck, deviated
 from ridempc.sim.motors import MotorCommand
 
 DT = 0.002  # [s] the rider's tick
@@ -215,3 +220,58 @@ def test_a_shared_estimate_is_read_and_left_for_the_own_filter_when_not_finite()
     primary.state.q[0] = 1.0  # once left, the own filter runs on
     assert shared.update(None).q[0] == 2.0 and own.updates == 1  # type: ignore[arg-type, union-attr]
     assert shared.detached and shared.state.q[0] == 2.0  # type: ignore[union-attr]
+
+
+def _joints_at(time: float) -> SimpleNamespace:
+    return SimpleNamespace(time=time, joint_position=np.full(3, 0.5))
+
+
+def test_the_start_window_is_the_riders_divergence_time() -> None:
+    # Cassie's centre of mass 0.8 m over her feet: 1/omega = sqrt(0.8/9.81) = 0.286 s
+    assert start_window(0.8) == pytest.approx(0.2856, abs=1e-4)
+    assert start_window(1.2) > start_window(0.8)  # a taller rider diverges slower
+    assert start_window(0.0) == pytest.approx(math.sqrt(0.1 / 9.81))  # never an empty window
+
+
+def _handover_at(time: float, com_height: float | None) -> Handover:
+    """A handover ridden on the primary from 0 s, failing at ``time`` [s]."""
+    handover = Handover(_Backup(), blend_s=0.0)  # type: ignore[arg-type]
+    for k in range(round(time / DT) + 1):
+        failure = "deviation" if k * DT >= time - 1e-9 else None
+        handover.step(_joints_at(k * DT), None, _command(0.0), failure, True, com_height)  # type: ignore[arg-type]
+    return handover
+
+
+def test_a_first_handover_in_the_starts_divergence_time_takes_no_fade() -> None:
+    # the joints 0.5 rad off the backup's targets (1): no offset laid over them
+    early = _handover_at(0.064, 0.8)  # the Segway's start handovers
+    assert early.fade_for(0.064, 0.8) == POSTURE_FADE_S  # a second handover would fade
+    sent = early.step(_joints_at(0.066), None, _command(0.0), "deviation", True, 0.8)  # type: ignore[arg-type]
+    assert sent.position[0] == 1.0
+    late = _handover_at(0.3, 0.8)  # past 0.286 s: a posture the plan chose, faded
+    sent = late.step(_joints_at(0.302), None, _command(0.0), "deviation", True, 0.8)  # type: ignore[arg-type]
+    assert sent.position[0] < 1.0
+
+
+def test_the_start_window_needs_a_height_and_a_start_on_the_primary() -> None:
+    unknown = _handover_at(0.064, None)  # no height told: the configured fade
+    sent = unknown.step(_joints_at(0.066), None, _command(0.0), "deviation", True)  # type: ignore[arg-type]
+    assert sent.position[0] < 1.0
+    handover = Handover(_Backup())  # type: ignore[arg-type]
+    handover.start_on_backup()
+    handover.step(_joints_at(0.0), None, _command(0.0), None, False, 0.8)  # type: ignore[arg-type]
+    assert handover.fade_for(0.1, 0.8) == POSTURE_FADE_S  # its posture at takeover: the backup's
+    handover.starting, handover.takeover_s = False, 0.05
+    assert handover.fade_for(0.1, 0.8) == POSTURE_FADE_S
+
+
+def test_the_deviation_hands_over_inside_the_backups_basin() -> None:
+    zeros = np.zeros((2, 1))
+    plan = Plan(zeros, zeros[:1], np.zeros(1), "solved", 0.0, False)
+
+    def at(level: float) -> str | None:
+        return deviated(HandoverCheck(plan, 0.0, level, False, True, DivergentDeviation()))
+
+    assert at(1.75) is None  # the library's largest: its manoeuvres ride on
+    assert at(1.25 * 1.75) is None
+    assert at(2.9) is not None  # at 3.0 the handed PD stood in 4 rides of 18: before that

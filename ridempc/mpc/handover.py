@@ -37,6 +37,24 @@ then commands its own state, not the rider's. So while the rider is off its refe
 (beyond the return band, where a handover may follow) it runs every tick, as in its own
 ride (:func:`standby_every`).
 
+A handover in the rider's first divergence time of a ride that started on the primary
+takes no posture fade (:meth:`Handover.fade_for`). A posture the primary *chose* (a deeper
+crouch, a pelvis twisted over the feet) takes its plan longer than the rider's divergence
+time to build,
+
+.. math:: T_{start} = 1 / \\omega = \\sqrt{h / g}
+
+(0.28 s for Cassie's centre of mass 0.8 m over her feet), since a plan brings a crouch in
+over seconds and a lean grows no faster than :math:`e^{\\omega t}`. A handover before
+:math:`T_{start}` finds no such posture, only the first ticks' tracking error of a model that
+does not fit the rider yet (a payload, a moved centre of mass: a knee bent 0.14-0.18 rad off
+the backup's targets within 0.064 s where the backup alone keeps it within 0.04 rad); laid
+over the backup's targets it would be held for half a second, and the backup, which stands
+the ride from its own start, would ride on from a buckled leg. So the backup's targets apply
+at once, as in its own ride. Only the ride's first handover, and only where the primary
+took the ride at the start (after a start on the backup the primary's posture at its
+takeover is the backup's own).
+
 A ride may also *start* on the backup (:meth:`Handover.start_on_backup`): the primary then
 takes the ride, blended in as on a return, the first tick it is *ready*
 (:mod:`ridempc.mpc.readiness` decides when); the start is not a fallback, and the time the
@@ -66,6 +84,7 @@ from ridempc.sim.sensors import SensorPacket
 __all__ = [
     "BLEND_S",
     "HANDOVER_DEVIATION",
+    "LEAD_DEVIATION",
     "RETURN_DEVIATION",
     "RETURN_DWELL_S",
     "RETURNS",
@@ -79,6 +98,7 @@ __all__ = [
     "deviation",
     "share_estimator",
     "standby_every",
+    "start_window",
 ]
 
 # [s] the blend of the two laws' commands: 10 ticks at 500 Hz, so no field of the command
@@ -100,11 +120,19 @@ RETURN_DWELL_S: float = 0.5
 # model met again, so the backup, which needs no model, keeps the ride.
 RETURNS: int = 1
 # [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
-# beyond which its linear model no longer holds and the ride is handed over: 1.7 times the
-# largest the MPC reached in the library's manoeuvres (1.40-1.75: Segway push and
-# velocity-steps, Hovershoes velocity-steps, skateboard push-off-0.5, seed 0).
-HANDOVER_DEVIATION: float = 3.0
-# [-] the same error below which the primary may ride again: a third of the handover's,
+# beyond which the ride is handed over: within the backup's basin, not at the edge of the
+# primary's model. 1.25 times the largest the MPC reached in the library's manoeuvres
+# (1.40-1.75: Segway push and velocity-steps, Hovershoes velocity-steps, skateboard
+# push-off-0.5), so those ride on without one; at 3.0 the handed PD was past its basin (on
+# 100 `hard` variants of each of Cassie's boards it saved 4 of the 18 rides handed over there).
+HANDOVER_DEVIATION: float = 2.2
+# [-] the same bound for the deviation's divergent lead while the primary is on probation
+# (:mod:`~ridempc.mpc.divergence`): a forecast a divergence time ahead, which a start's
+# transient the MPC rides reaches (2.97 on the Segway's velocity-steps, seed 0), and a
+# handover by it finds the backup within its basin (the handed PD stood in 42 of 57 such
+# rides); 1.7 times the library's largest deviation.
+LEAD_DEVIATION: float = 3.0
+# [-] the same error below which the primary may ride again: under half the handover's,
 # the band between them the hysteresis (standing still on the Hovershoes it sits at
 # 0.55-0.67 once settled).
 RETURN_DEVIATION: float = 1.0
@@ -115,6 +143,16 @@ RETURN_DEVIATION: float = 1.0
 STANDBY_DIVIDER: int = 15
 # [s] times within this are equal: a tick's time carries the rounding of its sum
 TIME_TOLERANCE: float = 1e-9
+GRAVITY: float = 9.81  # [m/s^2]
+# [m] the least centre-of-mass height start_window takes: a height not yet measured is no
+# reason for a window of zero
+MIN_COM_HEIGHT: float = 0.1
+
+
+def start_window(com_height: float) -> float:
+    """:math:`T_{start} = \\sqrt{h/g}` [s], the rider's divergence time, with the centre of
+    mass ``com_height`` [m] over the feet (at least :data:`MIN_COM_HEIGHT`)."""
+    return math.sqrt(max(com_height, MIN_COM_HEIGHT) / GRAVITY)
 
 
 @dataclass
@@ -189,7 +227,8 @@ class Handover:
             the first, off the ticks a primary with a slower loop of its own starts from.
         standby_phase: The tick of each ``standby_every`` the standby runs on (None: half
             a period, ``standby_every // 2``; :func:`~ridempc.mpc.stagger.standby_phase`).
-        fade_s: :math:`T_{fade}` [s] (0: none).
+        fade_s: :math:`T_{fade}` [s] (0: none); none in a start's first divergence time
+            (:meth:`fade_for`).
 
     Attributes:
         fallbacks: Every handover so far, in order.
@@ -222,6 +261,7 @@ class Handover:
         self._last_primary: MotorCommand | None = None
         self.starting = False  # the backup holds the ride's start (start_on_backup)
         self.takeover_s: float | None = None  # [s] when the primary took the start's ride
+        self._start: float | None = None  # [s] the ride's first tick
 
     def start_on_backup(self) -> None:
         """The ride starts on the backup; the primary takes it when ``step`` is told it is
@@ -237,6 +277,17 @@ class Handover:
             return math.inf
         return self.dwell_s * 2.0 ** max(len(self.fallbacks) - 1, 0)
 
+    def fade_for(self, now: float, com_height: float | None) -> float:
+        """The posture fade [s] for a handover at ``now`` [s]: none for the ride's first
+        handover within :func:`start_window` of its start, where the primary took the ride
+        at the start, with the centre of mass ``com_height`` [m] over the feet (None: not
+        known, the configured fade); :attr:`fade_s` otherwise."""
+        if com_height is None or self._start is None:
+            return self.fade_s
+        on_primary_from_start = self.takeover_s is None and not self.starting
+        early = now - self._start < start_window(com_height)
+        return 0.0 if on_primary_from_start and early and not self.fallbacks else self.fade_s
+
     @property
     def on_backup(self) -> bool:
         """Whether the backup rides."""
@@ -249,6 +300,7 @@ class Handover:
         primary: MotorCommand | None,
         failure: str | None,
         fit: bool,
+        com_height: float | None = None,
     ) -> MotorCommand:
         """One tick: the backup updated, the handover decided, the command to send.
 
@@ -260,8 +312,11 @@ class Handover:
             fit: Whether the primary is fit to ride again (plans and QPs solving, the state
                 near its reference); read only while the backup rides. While it holds the
                 start: whether the primary is ready to take it.
+            com_height: The centre of mass over the feet [m], for the start's window
+                (:meth:`fade_for`); None: not known.
         """
         now = sensors.time
+        self._start = now if self._start is None else self._start
         backup = self._backup(sensors, command, primary is None or failure is not None)
         if self.starting:
             if failure is None and primary is not None and fit:
@@ -275,12 +330,13 @@ class Handover:
                 self._last_primary = primary
                 return self._blended(now, primary)
             start = primary if primary is not None else self._last_primary
+            fade_s = self.fade_for(now, com_height)
             self.fallbacks.append(Fallback(now, failure or "no command"))
             self._switch(now, start if start is not None else backup)
             self._fit_since = None
-            if self.fade_s > 0.0:
+            if fade_s > 0.0:
                 joints = np.asarray(sensors.joint_position[: len(backup.position)], dtype=float)
-                self._fade = PostureFade(now, joints - backup.position, self.fade_s)
+                self._fade = PostureFade(now, joints - backup.position, fade_s)
             return self._blended(now, self._faded(now, backup))
         if failure is None and primary is not None and fit:
             self._fit_since = now if self._fit_since is None else self._fit_since

@@ -168,8 +168,7 @@ class MpcRider(RiderReports):
         primary, failure = self._primary(sensors, command)
         self._tick += 1
         starting = self.handover.starting
-        self.start_fade(sensors.time, self._com_height)  # mpc/start_fade.py
-        out = self.handover.step(sensors, command, primary, failure, self._fit())
+        out = self.handover.step(sensors, command, primary, failure, self._fit(), self._com_height)
         if starting and not self.handover.starting:  # its rate measured the backup's ride
             self.watch.divergence.reset()  # away from plans it did not follow
         self._diagnostics["on_backup"] = float(self.handover.on_backup)

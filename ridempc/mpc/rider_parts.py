@@ -53,7 +53,6 @@ from ridempc.mpc.stages.triggers import DropWatch, PushWatch, handover_triggers
 from ridempc.mpc.stages.turn import TurnSoFar
 from ridempc.mpc.stages.wbc_targets import TargetsFromPlan
 from ridempc.mpc.stagger import standby_phase
-from ridempc.mpc.start_fade import StartFade
 from ridempc.mpc.state_map import GROUND_FILTER_S, StateMap
 from ridempc.mpc.swing import ReferenceFeet
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
@@ -266,7 +265,6 @@ class RiderParts(Controller):
             standby_every=1,
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
         )
-        self.start_fade = StartFade(self.handover)  # none in a start's first ticks
         # the ride starts on the backup until the MPC is ready (mpc/readiness.py)
         self.readiness = start_readiness(stages.takeover, RETURN_DWELL_S)
         if self.readiness is not None:

@@ -12,8 +12,8 @@ backup law (:mod:`~ridempc.mpc.handover`):
    (:mod:`~ridempc.mpc.impulse`; with the ``impulse`` stage);
 5. :func:`deviated`: the state beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of
    its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`);
-6. :func:`diverging`: or heading there within a divergence time, until the MPC has held
-   the rider settled (:mod:`~ridempc.mpc.divergence`).
+6. :func:`diverging`: or heading beyond :data:`~ridempc.mpc.handover.LEAD_DEVIATION` within a
+   divergence time, until the MPC has held the rider settled (:mod:`~ridempc.mpc.divergence`).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 from ridempc.mpc.bounce import BounceRise
 from ridempc.mpc.divergence import DivergentDeviation
 from ridempc.mpc.drop import DropDetector
-from ridempc.mpc.handover import HANDOVER_DEVIATION
+from ridempc.mpc.handover import HANDOVER_DEVIATION, LEAD_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
 from ridempc.mpc.stages.base import ControlTick, present
@@ -84,9 +84,9 @@ def deviated(check: HandoverCheck) -> str | None:
 
 
 def diverging(check: HandoverCheck) -> str | None:
-    """The state heading beyond the handover's bound within a divergence time, while the
-    MPC is on probation."""
-    if not check.proven and check.divergence.value > HANDOVER_DEVIATION:
+    """The state heading beyond the lead's bound (:data:`~ridempc.mpc.handover.LEAD_DEVIATION`)
+    within a divergence time, while the MPC is on probation."""
+    if not check.proven and check.divergence.value > LEAD_DEVIATION:
         return (
             f"state {check.deviation:.2g} of its tolerances from the reference, "
             f"growing at {check.divergence.rate:.2g}/s"
