@@ -136,7 +136,6 @@ def test_cassie_rides_shoes_staggered_under_her_feet(monkeypatch: pytest.MonkeyP
     The MPC alone: the handover's early trigger hands this start to the PD
     (docs/tuning.md, h-ride), whose ride the observer does not fit, and the start is not
     held on the PD (the pair's ``takeover`` stage, mpc/readiness.py)."""
-    monkeypatch.setattr("ridempc.mpc.stages.triggers.HANDOVER_DEVIATION", math.inf)
     monkeypatch.setattr("ridempc.mpc.rider_parts.start_readiness", lambda *args: None)
     cassie = load_robot("cassie")
     board = load_board("hovershoes")
@@ -148,7 +147,7 @@ def test_cassie_rides_shoes_staggered_under_her_feet(monkeypatch: pytest.MonkeyP
         foot_offset=scenario.foot_offset,
         platform_offsets=scenario.platform_offsets,
     )
-    rider = MpcRider(cassie, "hovershoes")
+    rider = MpcRider(cassie, "hovershoes", hands_over_deviations=False)
     result = Simulation(scene, rider, scenario).run()
     assert result.status == "ok", result.fall_reason
     model, data = scene.model, scene.data
