@@ -124,6 +124,12 @@ class MpcSection(_Frozen):
         default=True,
         description="Solve a late plan from the state predicted at its take-up (mpc/delay.py).",
     )
+    handover_deviation: Positive = Field(
+        default=3.0,
+        le=10.0,
+        description="The state's error, in its tolerances, beyond which the ride is handed to "
+        "the PD (mpc/handover.py): the PD's basin; default the edge of the MPC's model.",
+    )
     unrealised_inputs: tuple[str, ...] = Field(
         default=(), description="Board inputs the rider does not realise, held at zero."
     )

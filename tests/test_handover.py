@@ -21,7 +21,8 @@ from ridempc.mpc.handover import (
     start_window,
 )
 from ridempc.mpc.plan import Plan
-from ridempc.mpc.stages.triggers import HandoverCheck, deviated
+from ridempc.mpc.stages.triggers import Deviated, HandoverCheck
+from ridempc.pair_description import load_pair_description
 from ridempc.sim.motors import MotorCommand
 
 DT = 0.002  # [s] the rider's tick
@@ -269,8 +270,11 @@ def test_the_deviation_hands_over_inside_the_backups_basin() -> None:
     zeros = np.zeros((2, 1))
     plan = Plan(zeros, zeros[:1], np.zeros(1), "solved", 0.0, False)
 
+    bound = load_pair_description("cassie", "hovershoes").mpc.handover_deviation
+
     def at(level: float) -> str | None:
-        return deviated(HandoverCheck(plan, 0.0, level, False, True, DivergentDeviation()))
+        check = HandoverCheck(plan, 0.0, level, False, True, DivergentDeviation())
+        return Deviated(bound)(check)
 
     assert at(1.75) is None  # the library's largest: its manoeuvres ride on
     assert at(1.25 * 1.75) is None

@@ -75,6 +75,14 @@ def test_the_triggers_give_the_first_reason_in_their_order() -> None:
     assert _reason(_check(deviation=far, stroke=True)) is None  # a re-push's stroke rides out
 
 
+def test_a_pairs_deviation_bound_hands_over_within_it() -> None:
+    near = 0.9 * HANDOVER_DEVIATION
+    assert _reason(_check(deviation=near)) is None
+    narrow = handover_triggers(None, None, deviation_bound=0.5 * HANDOVER_DEVIATION)
+    reasons = [trigger(_check(deviation=near)) for trigger in narrow]
+    assert any("from the reference" in str(reason) for reason in reasons)
+
+
 def test_the_mpc_alone_hands_over_only_its_own_failures() -> None:
     far = 2.0 * HANDOVER_DEVIATION
     assert _reason(_check(deviation=far), pushed=True, alone=True) is None

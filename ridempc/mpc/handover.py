@@ -120,12 +120,11 @@ RETURN_DWELL_S: float = 0.5
 # model met again, so the backup, which needs no model, keeps the ride.
 RETURNS: int = 1
 # [-] the primary's state error, in units of what its weights accept (:func:`deviation`),
-# beyond which the ride is handed over: within the backup's basin, not at the edge of the
-# primary's model. 1.25 times the largest the MPC reached in the library's manoeuvres
-# (1.40-1.75: Segway push and velocity-steps, Hovershoes velocity-steps, skateboard
-# push-off-0.5), so those ride on without one; at 3.0 the handed PD was past its basin (on
-# 100 `hard` variants of each of Cassie's boards it saved 4 of the 18 rides handed over there).
-HANDOVER_DEVIATION: float = 2.2
+# beyond which the ride is handed over, unless the pair sets its own (``[mpc]
+# handover_deviation``, the backup's basin where it is narrower): 1.7 times the largest the
+# MPC reached in the library's manoeuvres (1.40-1.75: Segway push and velocity-steps,
+# Hovershoes velocity-steps, skateboard push-off-0.5), the edge of its linear model.
+HANDOVER_DEVIATION: float = 3.0
 # [-] the same bound for the deviation's divergent lead while the primary is on probation
 # (:mod:`~ridempc.mpc.divergence`): a forecast a divergence time ahead, which a start's
 # transient the MPC rides reaches (2.97 on the Segway's velocity-steps, seed 0), and a

@@ -333,7 +333,11 @@ class RiderParts(Controller):
         self.drifts: tuple[DriftSource, ...] = self._drift_sources()
         self.shapers: tuple[ProblemShaper, ...] = self._problem_shapers()
         self.triggers = handover_triggers(
-            self.drop_watch, self.push_watch, self.flight, not self.hands_over_deviations
+            self.drop_watch,
+            self.push_watch,
+            self.flight,
+            not self.hands_over_deviations,
+            self.pair.description.mpc.handover_deviation,
         )
 
     def _drift_sources(self) -> tuple[DriftSource, ...]:

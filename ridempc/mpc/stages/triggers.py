@@ -10,7 +10,8 @@ backup law (:mod:`~ridempc.mpc.handover`):
 3. :func:`needs_slack`: the whole-body QP took slack on its soft rows (:mod:`ridempc.wbc.elastic`);
 4. :class:`PushWatch`: a push from outside beyond the pair's impulse band
    (:mod:`~ridempc.mpc.impulse`; with the ``impulse`` stage);
-5. :func:`deviated`: the state beyond :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION` of
+5. :class:`Deviated`: the state beyond the pair's ``[mpc] handover_deviation`` (default
+   :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION`) of
    its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`);
 6. :func:`diverging`: or heading beyond :data:`~ridempc.mpc.handover.LEAD_DEVIATION` within a
    divergence time, until the MPC has held the rider settled (:mod:`~ridempc.mpc.divergence`).
@@ -36,6 +37,7 @@ __all__ = [
     "HandoverCheck",
     "HandoverTrigger",
     "PushWatch",
+    "Deviated",
     "deviated",
     "diverging",
     "handover_triggers",
@@ -75,12 +77,20 @@ def needs_slack(check: HandoverCheck) -> str | None:
     return f"whole-body QP infeasible (slack {slack:.3g})" if slack > 0.0 else None
 
 
-def deviated(check: HandoverCheck) -> str | None:
-    """The state beyond the handover's bound of its reference (unless a re-push's stroke
-    defers it)."""
-    if check.deviation > HANDOVER_DEVIATION and not check.stroke:
-        return f"state {check.deviation:.2g} of its tolerances from the reference"
-    return None
+class Deviated:
+    """The state beyond ``bound`` [-] of its reference, in its tolerances (unless a
+    re-push's stroke defers it); the pair's ``[mpc] handover_deviation``."""
+
+    def __init__(self, bound: float = HANDOVER_DEVIATION) -> None:
+        self.bound = bound
+
+    def __call__(self, check: HandoverCheck) -> str | None:
+        if check.deviation > self.bound and not check.stroke:
+            return f"state {check.deviation:.2g} of its tolerances from the reference"
+        return None
+
+
+deviated = Deviated()  # at the default bound, :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION`
 
 
 def diverging(check: HandoverCheck) -> str | None:
@@ -165,6 +175,7 @@ def handover_triggers(
     push: PushWatch | None,
     flight: HandoverTrigger | None = None,
     failures_only: bool = False,
+    deviation_bound: float = HANDOVER_DEVIATION,
 ) -> tuple[HandoverTrigger, ...]:
     """The triggers in the order asked (the first reason is the one recorded), with the
     pair's watches where it has them; a drop's flight (:mod:`~ridempc.mpc.flight`) in the
@@ -173,4 +184,5 @@ def handover_triggers(
     measures the MPC itself (the ``mpc-alone`` ablation), no push or deviation handed over."""
     if failures_only:
         return present(plan_failed, flight or drop, needs_slack)
-    return present(plan_failed, flight or drop, needs_slack, push, deviated, diverging)
+    far = Deviated(deviation_bound)
+    return present(plan_failed, flight or drop, needs_slack, push, far, diverging)
