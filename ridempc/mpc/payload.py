@@ -233,7 +233,10 @@ class PayloadEstimator:
         self, loads: Array, contact: NDArray[np.bool_], motor_torque: Array, imu: ImuReading
     ) -> None:
         """One control tick's reading: each foot's load fraction [-], its contact flag, the
-        motor torques [N m] and the IMU; a foot off contact drops the step's readings."""
+        motor torques [N m] and the IMU; a foot off contact drops the step's readings; none
+        taken once the mass is weighed another way (:meth:`weigh`: :meth:`update` drops them)."""
+        if self._weighed is not None:
+            return
         if not np.all(contact):
             self.reset()
             return
