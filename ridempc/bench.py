@@ -396,9 +396,7 @@ def _other_solvers(qp: Any, problems: list) -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     data = []
     for problem in problems:
-        p, a = qp.matrices(problem)
-        lower, upper = qp.bounds(problem)
-        data.append((p, a, lower, upper))
+        data.append(qp.whole(problem))
     layout = _stage_layout(qp.horizon, qp.nx, qp.nu, qp.n_constraints)
     reference, reference_u0 = [], []
     first = slice((qp.horizon + 1) * qp.nx, (qp.horizon + 1) * qp.nx + qp.nu)  # u_0, scaled

@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 
 from ridempc.baselines.hovershoe_gains import TurningGains, VelocityGains, XAxisGains, YAxisGains
+from ridempc.gravity import GRAVITY
 
 __all__ = [
     "GRAVITY",
@@ -34,8 +35,6 @@ __all__ = [
     "toe_difference_torque",
     "turning",
 ]
-
-GRAVITY: float = 9.81  # [m] / [s]^2, as printed in eq. (21)
 
 
 def _clip(value: float, bound: float) -> float:

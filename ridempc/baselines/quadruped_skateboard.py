@@ -111,6 +111,7 @@ from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState, StateEstimator
 from ridempc.estimation.lapack import solve
+from ridempc.gravity import GRAVITY
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
 from ridempc.rotations import exp3, quaternion_to_matrix, rotation_y, rotation_z
@@ -121,7 +122,6 @@ from ridempc.sim.sensors import SensorPacket
 __all__ = ["QuadrupedSkateboardPD", "StanceState"]
 
 Array = NDArray[np.float64]
-GRAVITY: float = 9.81  # [m] / [s]^2
 
 
 def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:

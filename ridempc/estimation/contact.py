@@ -31,6 +31,7 @@ from ridempc.errors import ConfigError, UnknownNameError
 from ridempc.estimation.lapack import solve
 from ridempc.estimation.legs import LegKinematics, LegReading
 from ridempc.estimation.parameters import EstimatorParameters
+from ridempc.gravity import GRAVITY as STANDARD_GRAVITY
 from ridempc.robots.pinocchio_model import PinocchioRobot
 from ridempc.robots.robot import Robot
 
@@ -45,7 +46,6 @@ __all__ = [
 
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
-STANDARD_GRAVITY: float = 9.81  # [m/s^2]
 
 
 class FootLoad(ABC):

@@ -24,14 +24,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.gravity import GRAVITY_WORLD as GRAVITY
 from ridempc.robots.pinocchio_model import PinocchioRobot
 from ridempc.rotations import matrix_to_quaternion
 
 __all__ = ["GRAVITY", "BaseAttitude", "ImuMount"]
 
 Array = NDArray[np.float64]
-GRAVITY: Array = np.array([0.0, 0.0, -9.81])  # [m/s^2], world frame
-GRAVITY.flags.writeable = False
 
 
 @dataclass(frozen=True)

@@ -37,11 +37,11 @@ from __future__ import annotations
 
 import math
 
+from ridempc.gravity import GRAVITY
 from ridempc.mpc.handover import TIME_TOLERANCE
 
 __all__ = ["GRAVITY", "RATE_FILTER_S", "DivergentDeviation", "Probation"]
 
-GRAVITY: float = 9.81  # [m/s^2]
 # [s] the unexpected growth low-passed over a third of a rider's divergence time (Cassie's
 # 1/omega = 0.3 s): one MPC step's surprise (1/30 s) carries the estimate's noise
 RATE_FILTER_S: float = 0.1

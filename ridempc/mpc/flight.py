@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ridempc.estimation.state import EstimatedState
+from ridempc.gravity import GRAVITY
 from ridempc.mpc.drop import SINK_SPEED
 from ridempc.mpc.stages.base import ControlTick
 from ridempc.mpc.stages.feet_targets import FootTargets
@@ -54,7 +55,6 @@ LAND_TICKS: int = 5
 # [s] the longest drop ridden: free fall through 2 wheel radii of the largest board
 # (0.1 m, 0.14 s) and the legs' reach after it; a longer one is no step.
 LONGEST_S: float = 0.3
-GRAVITY: float = 9.81  # [m/s^2]
 
 
 class DropFlight:

@@ -77,6 +77,7 @@ from numpy.typing import NDArray
 
 from ridempc.controllers.base import Controller
 from ridempc.estimation import EstimatedState, StateEstimator
+from ridempc.gravity import GRAVITY
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
 from ridempc.sim.sensors import SensorPacket
@@ -142,7 +143,6 @@ RETURN_DEVIATION: float = 1.0
 STANDBY_DIVIDER: int = 15
 # [s] times within this are equal: a tick's time carries the rounding of its sum
 TIME_TOLERANCE: float = 1e-9
-GRAVITY: float = 9.81  # [m/s^2]
 # [m] the least centre-of-mass height start_window takes: a height not yet measured is no
 # reason for a window of zero
 MIN_COM_HEIGHT: float = 0.1

@@ -40,6 +40,8 @@ from collections import deque
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.gravity import GRAVITY_WORLD as GRAVITY
+
 __all__ = [
     "BASELINE_S",
     "GRAVITY",
@@ -49,7 +51,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-GRAVITY: Array = np.array([0.0, 0.0, -9.81])  # [m/s^2] in the world
 # [s] the window the impulse is summed over: twice the push (0.2 s), so a push's
 # whole impulse is counted, and about one divergence time of a rider (Cassie's 0.3 s), so
 # a slow drift the disturbance observer takes up does not add up to a push

@@ -71,6 +71,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.estimation.legs import LegKinematics
+from ridempc.gravity import GRAVITY
 from ridempc.robots.pinocchio_model import PinocchioRobot
 from ridempc.robots.robot import Robot
 
@@ -89,7 +90,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-GRAVITY: float = 9.81  # [m/s^2]
 # A third of the balance's own time, sqrt(h/g) ~ 0.3 s for a 0.9 m centre of mass: the
 # estimate settles before the fall it is there to prevent.
 TIME_CONSTANT_S: float = 0.1

@@ -273,8 +273,7 @@ class MpcQP:
             )
         }
         self._build_pattern()
-        hessian, csc = self.matrices(problem)
-        _, lower, upper = self._data(problem)
+        hessian, csc, lower, upper = self.whole(problem)
         self._solver = osqp.OSQP()
         self._solver.setup(hessian, np.zeros(self.n_variables), csc, lower, upper, **self.settings)
         self.row_classes = RowClasses(lower, upper, self._indices) if held else None
@@ -460,13 +459,7 @@ class MpcQP:
         Raises:
             ValueError: As :meth:`update`.
         """
-        self._check_sizes(problem)
-        values, _, _ = self._data(problem)
-        n = self.n_variables
-        hessian = sp.csc_matrix((self._weights(problem), np.arange(n), np.arange(n + 1)), (n, n))
-        constraints = sp.csc_matrix(
-            (values, self._indices.copy(), self._indptr.copy()), shape=(self.n_rows, n)
-        )
+        hessian, constraints, _, _ = self.whole(problem)
         return hessian, constraints
 
     def bounds(self, problem: MpcProblem) -> tuple[Array, Array]:
@@ -479,6 +472,22 @@ class MpcQP:
         self._check_sizes(problem)
         _, lower, upper = self._data(problem)
         return lower, upper
+
+    def whole(self, problem: MpcProblem) -> tuple[sp.csc_matrix, sp.csc_matrix, Array, Array]:
+        """:meth:`matrices` and :meth:`bounds` at once, ``problem`` read once: the scaled
+        :math:`P, A_{qp}, l, u` (a solver set up from scratch, the elastic rescue, the bench).
+
+        Raises:
+            ValueError: As :meth:`update`.
+        """
+        self._check_sizes(problem)
+        values, lower, upper = self._data(problem)
+        n = self.n_variables
+        hessian = sp.csc_matrix((self._weights(problem), np.arange(n), np.arange(n + 1)), (n, n))
+        constraints = sp.csc_matrix(
+            (values, self._indices.copy(), self._indptr.copy()), shape=(self.n_rows, n)
+        )
+        return hessian, constraints, lower, upper
 
     def update(self, problem: MpcProblem) -> None:
         """Write ``problem``'s values into the fixed pattern (no new setup).
@@ -626,7 +635,7 @@ class MpcQP:
             self._previous_dual = np.asarray(result.y, dtype=float).copy()
         elif self._rescues(outcome):
             assert self.rescue is not None
-            rescued = self.rescue.solve(*self.matrices(problem), *self.bounds(problem))
+            rescued = self.rescue.solve(*self.whole(problem))
             if rescued.z is not None:  # the previous dual kept for the next warm start
                 scaled, status = rescued.z, f"{status}, elastic (slack {rescued.slack:.2g})"
         if scaled is not None:

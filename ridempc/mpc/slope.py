@@ -29,10 +29,10 @@ import math
 from collections.abc import Sequence
 
 from ridempc.estimation.state import BoardEstimate
+from ridempc.gravity import GRAVITY
 
 __all__ = ["GRAVITY", "MAX_SLOPE", "MIN_SPEED", "TIME_CONSTANT", "SlopeEstimator"]
 
-GRAVITY: float = 9.81  # [m/s^2]
 # Below 0.15 m/s a centimetre-per-second error in the velocity tilts the estimate by 4 deg.
 MIN_SPEED: float = 0.15  # [m/s]
 # Steeper than any ramp a board is ridden on (the scenarios' steepest: 13 deg); a step's

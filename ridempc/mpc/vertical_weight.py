@@ -36,13 +36,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from ridempc.gravity import GRAVITY
 from ridempc.mpc.disturbance import DisturbanceObserver
 from ridempc.mpc.stages.base import MpcTick
 
 __all__ = ["MASS_BOUND", "TIME_CONSTANT_S", "VerticalWeight"]
 
 Array = NDArray[np.float64]
-GRAVITY: float = 9.81  # [m/s^2]
 # [s] the observer's time constant: above the balance's own time sqrt(h/g) ~ 0.3 s, since
 # one MPC step's residual swings by 5-6 m/s^2 (half the weight) with the rider's vertical
 # sway on her sprung legs, and a faster estimate passes that swing to the plan.

@@ -40,6 +40,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
+from ridempc.gravity import GRAVITY
 from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -56,7 +57,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-GRAVITY: float = 9.81  # [m] / [s]^2
 
 
 def rigid_body_state_names(base: str) -> tuple[str, ...]:

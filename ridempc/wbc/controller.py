@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.estimation.state import EstimatedState
+from ridempc.gravity import GRAVITY
 from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.robots.pinocchio_model import PinocchioRobot
 from ridempc.robots.robot import Robot
@@ -75,7 +76,6 @@ TRACKED_POINTS: dict[str, type[TranslationTask]] = {
     "com": CenterOfMassTask,
     "base": BasePositionTask,
 }
-GRAVITY: float = 9.81  # [m] / [s]^2
 
 
 def _motor_q(pinocchio: PinocchioRobot, robot: Robot) -> NDArray[np.int64]:
