@@ -37,12 +37,10 @@ def _stored_fields(cls: type) -> tuple[frozenset[str], tuple[str, ...]] | None:
     init = cls.__dict__.get("__init__")
     if getattr(getattr(init, "__code__", None), "co_filename", None) != "<string>":
         return None  # not the __init__ that dataclasses wrote (exec'd source) for this class
-    kinds = {f._field_type for f in every.values()}  # type: ignore[attr-defined]
-    if kinds - {dataclasses._FIELD, dataclasses._FIELD_CLASSVAR}:  # type: ignore[attr-defined]
-        return None  # an InitVar: __init__ does more than store
-    names = tuple(f.name for f in dataclasses.fields(cls))
-    if not all(f.init for f in dataclasses.fields(cls)):
-        return None
+    fields = dataclasses.fields(cls)
+    if len(fields) != len(every) or not all(f.init for f in fields):
+        return None  # an InitVar (or a ClassVar), or a field __init__ does not take
+    names = tuple(f.name for f in fields)
     return frozenset(names), names
 
 
