@@ -61,7 +61,6 @@ on shoe 0) and reports it through :meth:`estimate`; it never reads ``truth``. Ga
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -84,6 +83,7 @@ from ridempc.baselines.hovershoe_laws import (
     turning,
 )
 from ridempc.estimation import EstimatedState
+from ridempc.frozen import changed
 from ridempc.robots.robot import Robot
 from ridempc.scenarios.scenario import Command
 from ridempc.sim.motors import MotorCommand
@@ -207,7 +207,7 @@ class CassieHovershoes(CassieStanding):
             hip_roll = float(
                 np.arcsin(np.clip(np.sin(hip_roll) + command.lateral_offset / reach, -1.0, 1.0))
             )
-        targets = dataclasses.replace(
+        targets = changed(
             nominal,
             com_x=nominal.com_x + com_x_target(g.velocity, speed, command.velocity),
             com_y=turn.com_y,
@@ -285,7 +285,7 @@ class CassieHovershoes(CassieStanding):
             left_hip_yaw_target=yaw_targets[0],
             right_hip_yaw_target=yaw_targets[1],
         )
-        return dataclasses.replace(nominal, torque=torque, position=position, kp=kp, kd=kd)
+        return changed(nominal, torque=torque, position=position, kp=kp, kd=kd)
 
     def _integrate(self, time: float, error: float) -> float:
         """:math:`\\int e_{yaw} dt` [rad], held where its toe torque reaches ``integral_limit``."""
@@ -325,7 +325,7 @@ class CassieHovershoes(CassieStanding):
         com[0] = state.support_centre[0] + self._loaded_com_x[0]
         com_velocity = state.com_velocity.copy()
         com_velocity[0] = self._loaded_com_x[1]
-        return dataclasses.replace(state, com=com, com_velocity=com_velocity)
+        return changed(state, com=com, com_velocity=com_velocity)
 
     def leg_extension(self, side: str) -> float:
         """An unloaded leg reaches down after its falling shoe; loaded again, it shortens back
@@ -350,7 +350,7 @@ class CassieHovershoes(CassieStanding):
         self._diagnostics.update(
             left_unloaded=float(self._unloaded[0]), right_unloaded=float(self._unloaded[1])
         )
-        return dataclasses.replace(command, torque=torque, position=position, kp=kp)
+        return changed(command, torque=torque, position=position, kp=kp)
 
     @staticmethod
     def _foot_pitches(state: KinematicState) -> Array:

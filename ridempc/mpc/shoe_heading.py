@@ -31,11 +31,11 @@ is then taken up by the hips' yaw.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
 from ridempc.estimation.state import BoardEstimate, EstimatedState
+from ridempc.frozen import changed
 from ridempc.rotations import wrap_angle
 
 __all__ = ["MIN_SPEED", "TIME_CONSTANT", "ShoeHeading"]
@@ -81,5 +81,5 @@ class ShoeHeading:
                 if vx * math.cos(board.yaw) + vy * math.sin(board.yaw) < 0.0:
                     travel += math.pi  # rolling backwards
                 self.slip[k] += share * wrap_angle(board.yaw - travel - self.slip[k])
-            boards.append(replace(board, yaw=wrap_angle(board.yaw - float(self.slip[k]))))
-        return replace(estimate, boards=tuple(boards))
+            boards.append(changed(board, yaw=wrap_angle(board.yaw - float(self.slip[k]))))
+        return changed(estimate, boards=tuple(boards))

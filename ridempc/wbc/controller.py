@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from ridempc.errors import ConfigError
 from ridempc.estimation.state import EstimatedState
+from ridempc.frozen import changed
 from ridempc.gravity import GRAVITY
 from ridempc.robots.motor_curve import TorqueSpeedCurve
 from ridempc.robots.pinocchio_model import PinocchioRobot
@@ -260,7 +261,7 @@ class WholeBodyController:
         )
         least = self.in_flight.least_forces(state.time, targets.forces[:, 2])
         if least is not None:
-            contacts = replace(contacts, least_force=least)
+            contacts = changed(contacts, least_force=least)
         problem = self.qp.build(terms, targets, contacts)
         build_time = time.perf_counter()
         solution = self.qp.solve(problem)
