@@ -10,7 +10,11 @@ each further handover, :meth:`Handover.dwell`), at most :data:`RETURNS` times a 
 .. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
           \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
 
-over every field of the motor command (feedforward torque, targets and gains). A backup
+over every field of the motor command (feedforward torque, targets and gains), where
+:math:`u_{from}` is the command the motors hold, the one sent the tick before: never the
+failing tick's own, which the triggers judged unfit (a plan solved from a state past the
+model's edge asks the Segway rider's knees for 100-225 N m off the tick before's, a kick
+that slides a foot on a low-friction deck). A backup
 handed a rider in another posture than its own (the MPC twists the pelvis over the feet, or
 crouches) would pull every joint to its posture at once, its stiffness times the posture's
 error (0.25 rad of hip yaw at 300 N m/rad: 75 N m, which turns the shoes under the rider);
@@ -257,7 +261,7 @@ class Handover:
         self._switch_time: float | None = None  # [s] the last switch, either way
         self._from: MotorCommand | None = None  # the command blended out of since then
         self._fit_since: float | None = None
-        self._last_primary: MotorCommand | None = None
+        self._sent: MotorCommand | None = None  # the command step returned last: the motors'
         self.starting = False  # the backup holds the ride's start (start_on_backup)
         self.takeover_s: float | None = None  # [s] when the primary took the start's ride
         self._start: float | None = None  # [s] the ride's first tick
@@ -314,6 +318,18 @@ class Handover:
             com_height: The centre of mass over the feet [m], for the start's window
                 (:meth:`fade_for`); None: not known.
         """
+        self._sent = self._step(sensors, command, primary, failure, fit, com_height)
+        return self._sent
+
+    def _step(
+        self,
+        sensors: SensorPacket,
+        command: Command,
+        primary: MotorCommand | None,
+        failure: str | None,
+        fit: bool,
+        com_height: float | None,
+    ) -> MotorCommand:
         now = sensors.time
         self._start = now if self._start is None else self._start
         backup = self._backup(sensors, command, primary is None or failure is not None)
@@ -321,14 +337,13 @@ class Handover:
             if failure is None and primary is not None and fit:
                 self.starting, self.takeover_s = False, now
                 self._switch(now, self._blended(now, backup))
-                self._last_primary = primary
                 return self._blended(now, primary)
             return self._blended(now, backup)
         if not self.on_backup:
             if failure is None and primary is not None:
-                self._last_primary = primary
                 return self._blended(now, primary)
-            start = primary if primary is not None else self._last_primary
+            # bumpless: out of what the motors hold, never the unfit tick's command
+            start = self._sent
             fade_s = self.fade_for(now, com_height)
             self.fallbacks.append(Fallback(now, failure or "no command"))
             self._switch(now, start if start is not None else backup)
@@ -344,7 +359,6 @@ class Handover:
                 current.duration_s = now - current.time_s
                 self._switch(now, self._blended(now, self._faded(now, backup)))
                 self._fade = None
-                self._last_primary = primary
                 return self._blended(now, primary)
         else:
             self._fit_since = None
