@@ -205,8 +205,7 @@ class PayloadStage(_Frozen):
     start_reading: Positive | None = Field(
         default=None,
         le=10.0,
-        description="The nominal rider's load reading at its first tick [-] (mass_from "
-        "'start').",
+        description="The nominal rider's first load reading [-] (mass_from 'start').",
     )
 
     @model_validator(mode="after")
