@@ -1,8 +1,9 @@
 """The rider weighed at the ride's first tick (:mod:`ridempc.mpc.start_weight`).
 
-- Cassie on the Segway, a payload on her pelvis (heavier) or every body scaled (lighter), 30 %
-  either way: the first tick's reading weighs her within 5 % of the model's mass, and the
-  nominal rider reads no payload; the estimate is in the models before the first plan.
+- Cassie on the Segway (its pair with the stage switched on: no pair file uses it, docs/tuning.md,
+  session 12), a payload on her pelvis (heavier) or every body scaled (lighter), 30 % either
+  way: the first tick's reading weighs her within 5 % of the model's mass, and the nominal rider
+  reads no payload; the estimate is in the models before the first plan.
 - Weighed once: later readings do not move it; no reading yet (a foot off contact), no weight.
 - The pair file names the weighing with its calibration, and refuses either alone.
 """
@@ -17,11 +18,13 @@ import pytest
 import ridempc
 from ridempc.controllers.registry import make_controller
 from ridempc.errors import ConfigError
+from ridempc.mpc.pairs import MpcPair, load_mpc_pair
 from ridempc.mpc.start_weight import StartWeight
 from ridempc.pair_description import PayloadStage
 from ridempc.robots import load_robot
 
 MODEL_MASS = 32.8226  # [kg] Cassie's model
+START_READING = 0.9017  # [-] the nominal rider's first reading in ride_segway_crouch
 
 SCENARIO = """name = "stand-still-payload"
 duration = 1.0
@@ -41,7 +44,18 @@ offset = [0.0, 0.0, 0.0]
 
 
 @pytest.mark.parametrize("fraction", [-0.3, 0.0, 0.3])
-def test_the_first_tick_weighs_the_segway_rider(fraction: float, tmp_path: Path) -> None:
+def test_the_first_tick_weighs_the_segway_rider(
+    fraction: float, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ridempc.mpc import rider_parts
+
+    def weighed_pair(robot: str, board: str) -> MpcPair:
+        pair = load_mpc_pair(robot, board)
+        stage = PayloadStage(mass_from="start", start_reading=START_READING)
+        stages = pair.description.stages.model_copy(update={"payload": stage})
+        return pair._replace(description=pair.description.model_copy(update={"stages": stages}))
+
+    monkeypatch.setattr(rider_parts, "load_mpc_pair", weighed_pair)
     mass = fraction * MODEL_MASS
     if fraction == 0.0:
         scenario: str | Path = "stand-still"

@@ -26,7 +26,10 @@ crouch's load path, which the start's does not.
 On Cassie on the Segway, ``hard`` seed 151's first 30 variants (payload -30..+30 %): read
 within 0.45 kg for lighter riders (4 % of the payload, every body scaled), and within
 +1.5/-3.1 kg for heavier ones (a mass on the pelvis 5-10 cm ahead or behind pitches the
-pelvis, and the IMU's reading with it; docs/tuning.md, session 12).
+pelvis, and the IMU's reading with it; docs/tuning.md, session 12). A pair weighs its rider
+so with ``[stages.payload] mass_from = "start"`` and its ``start_reading`` (Cassie on the
+Segway: 0.9017); none does yet: on the Segway's ``hard`` rides the mass without the centre of
+mass's offset and height lost as many rides as it saved.
 """
 
 from __future__ import annotations
