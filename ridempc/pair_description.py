@@ -197,11 +197,22 @@ class SettleStage(_Frozen):
 
 
 class PayloadStage(_Frozen):
-    mass_from: Literal["loads", "prediction"] = Field(
+    mass_from: Literal["loads", "prediction", "start"] = Field(
         default="loads",
-        description="The rider's mass weighed by the feet's loads or by the MPC's vertical "
-        "prediction error.",
+        description="The rider's mass weighed by the feet's loads, by the MPC's vertical "
+        "prediction error, or once at the ride's first tick (mpc/start_weight.py).",
     )
+    start_reading: Positive | None = Field(
+        default=None,
+        le=10.0,
+        description="The nominal rider's first load reading [-] (mass_from 'start').",
+    )
+
+    @model_validator(mode="after")
+    def _start_calibrated(self) -> PayloadStage:
+        if (self.mass_from == "start") != (self.start_reading is not None):
+            raise ValueError("start_reading: given with mass_from 'start' and only then")
+        return self
 
 
 class DisturbanceStage(_Frozen):

@@ -225,6 +225,18 @@ class PayloadEstimator:
         pin.centerOfMass(self.model, self.data, q, v)
         return np.array(self.data.vcom[0])
 
+    def reading(self) -> float | None:
+        """The mean of the readings since the last :meth:`update` as a mass ratio,
+        :math:`\\sum_i \\ell_i\\, m_0 g / n / (m_0 f_z)` [-] (module docstring; the load
+        signals uncalibrated), None without one or with :math:`f_z \\le g/2` (falling)."""
+        if self._sum is None:
+            return None
+        n = len(self.legs.feet)
+        mean = self._sum / self._count
+        if mean[-1] <= 0.5 * GRAVITY:
+            return None
+        return float(np.sum(mean[:n]) * self.share / (self.mass0 * mean[-1]))
+
     def reset(self) -> None:
         """Forget the readings since the last :meth:`update`."""
         self._sum, self._count = None, 0

@@ -45,7 +45,7 @@ from ridempc.mpc.stages.feet_targets import FeetTargets
 from ridempc.mpc.stages.frame_follow import CommandedFrame
 from ridempc.mpc.stages.manoeuvre_choice import ManoeuvreChoice
 from ridempc.mpc.stages.manoeuvre_shapers import Coasting, RepushBlend, RollCommand, Turn
-from ridempc.mpc.stages.payload_models import PayloadModels, weighed
+from ridempc.mpc.stages.payload_models import PayloadModels, start_weight, weighed
 from ridempc.mpc.stages.plan_watch import PlanWatch
 from ridempc.mpc.stages.shoes import ShoeUpdate, shoe_stages
 from ridempc.mpc.stages.support import contacts_to_feet
@@ -285,6 +285,7 @@ class RiderParts(Controller):
                 weighed(
                     stages.payload, self.layout.names["vz"], self.payload, self.mpc.settings.dt
                 ),
+                start_weight(stages.payload),
             )
             if self.payload is not None
             else None

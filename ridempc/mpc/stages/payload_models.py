@@ -9,7 +9,9 @@ mass), and its weight the MPC's vertical rate carries as a drift
 :class:`~ridempc.mpc.stages.base.TickObserver` and a drift source. With a
 :class:`~ridempc.mpc.vertical_weight.VerticalWeight` the mass is weighed by the MPC's own
 vertical prediction error instead of the feet's loads (the pair's ``[stages.payload]
-mass_from = "prediction"``), updated with the drift and in the models from the next MPC tick.
+mass_from = "prediction"``), updated with the drift and in the models from the next MPC tick;
+with a :class:`~ridempc.mpc.start_weight.StartWeight` it is weighed once, at the first MPC
+tick, before the first plan (``mass_from = "start"``).
 """
 
 from __future__ import annotations
@@ -23,10 +25,11 @@ from numpy.typing import NDArray
 from ridempc.estimation import EstimatedState
 from ridempc.mpc.payload import PayloadEstimator
 from ridempc.mpc.stages.base import ControlTick, MpcTick
+from ridempc.mpc.start_weight import StartWeight
 from ridempc.mpc.vertical_weight import VerticalWeight
 from ridempc.pair_description import PayloadStage
 
-__all__ = ["PayloadModels", "weighed"]
+__all__ = ["PayloadModels", "start_weight", "weighed"]
 
 Array = NDArray[np.float64]
 
@@ -42,6 +45,14 @@ def weighed(
     return VerticalWeight(vz, payload.mass0, dt)
 
 
+def start_weight(stage: PayloadStage | None) -> StartWeight | None:
+    """The mass weighed at the ride's first tick, if the pair's payload stage asks for it
+    (``mass_from = "start"``, calibrated by its ``start_reading``)."""
+    if stage is None or stage.start_reading is None:
+        return None
+    return StartWeight(float(stage.start_reading))
+
+
 class PayloadModels:
     """The payload's estimate read every tick and put into the models at each MPC tick.
 
@@ -52,6 +63,7 @@ class PayloadModels:
         com: The estimate's centre of mass [m], world frame (from the map's model).
         vz: The vertical rate's row in the MPC's state.
         weight: The mass weighed by the vertical prediction error, or None (the loads').
+        start: The mass weighed at the ride's first tick, or None.
     """
 
     def __init__(
@@ -61,9 +73,10 @@ class PayloadModels:
         com: Callable[[EstimatedState], Array],
         vz: int,
         weight: VerticalWeight | None = None,
+        start: StartWeight | None = None,
     ) -> None:
         self.payload, self._models, self._com, self._vz = payload, tuple(models), com, vz
-        self.weight = weight
+        self.weight, self.start = weight, start
         self._open_loop = False  # the backup rode the last control tick: no loop closed
 
     def observe(self, tick: ControlTick) -> None:
@@ -76,7 +89,10 @@ class PayloadModels:
     def absorb(self, tick: MpcTick) -> None:
         """The estimate over the last MPC step (dropped unless balancing) into the models:
         while the backup rides, the running mean of the readings
-        (:meth:`~ridempc.mpc.payload.PayloadEstimator.update`'s ``open_loop``)."""
+        (:meth:`~ridempc.mpc.payload.PayloadEstimator.update`'s ``open_loop``); weighed
+        first by the start's weighing, if any and not yet done."""
+        if self.start is not None:
+            self.start.weigh(self.payload)
         if not tick.balancing:
             self.payload.reset()
         estimate = tick.estimate
