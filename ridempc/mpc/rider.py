@@ -221,6 +221,7 @@ class MpcRider(RiderReports):
             stroke,
             self.watch.probation.proven,
             self.watch.divergence,
+            self.push_watch is not None and self.push_watch.riding,
         )
         for trigger in self.triggers:  # the first reason hands the ride over
             reason = trigger(check)

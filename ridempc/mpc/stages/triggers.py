@@ -12,7 +12,8 @@ backup law (:mod:`~ridempc.mpc.handover`):
    (:mod:`~ridempc.mpc.impulse`; with the ``impulse`` stage);
 5. :class:`Deviated`: the state beyond the pair's ``[mpc] handover_deviation`` (default
    :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION`) of
-   its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`);
+   its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`; so
+   does a push inside the impulse band where the pair says so, :mod:`~ridempc.mpc.push_ride`);
 6. :func:`diverging`: or heading beyond :data:`~ridempc.mpc.handover.LEAD_DEVIATION` within a
    divergence time, until the MPC has held the rider settled (:mod:`~ridempc.mpc.divergence`).
 """
@@ -29,6 +30,7 @@ from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION, LEAD_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
+from ridempc.mpc.push_ride import band_share, rides_push
 from ridempc.mpc.stages.base import ControlTick, present
 from ridempc.pair_description import ImpulseStage
 
@@ -49,8 +51,9 @@ __all__ = [
 class HandoverCheck(NamedTuple):
     """What the triggers read after a tick's whole-body QP: the plan in force, the QP's
     slack, the state's deviation from its reference [-], whether a re-push's stroke defers
-    it, whether the MPC has proven itself since the start or its return, and the
-    deviation's divergence."""
+    it, whether the MPC has proven itself since the start or its return, the
+    deviation's divergence, and whether a push inside the impulse band defers the
+    deviation (:mod:`~ridempc.mpc.push_ride`)."""
 
     plan: Plan
     slack: float
@@ -58,6 +61,7 @@ class HandoverCheck(NamedTuple):
     stroke: bool
     proven: bool
     divergence: DivergentDeviation
+    riding: bool = False
 
 
 class HandoverTrigger(Protocol):
@@ -79,13 +83,14 @@ def needs_slack(check: HandoverCheck) -> str | None:
 
 class Deviated:
     """The state beyond ``bound`` [-] of its reference, in its tolerances (unless a
-    re-push's stroke defers it); the pair's ``[mpc] handover_deviation``."""
+    re-push's stroke or a push ridden inside the band defers it); the pair's ``[mpc]
+    handover_deviation``."""
 
     def __init__(self, bound: float = HANDOVER_DEVIATION) -> None:
         self.bound = bound
 
     def __call__(self, check: HandoverCheck) -> str | None:
-        if check.deviation > self.bound and not check.stroke:
+        if check.deviation > self.bound and not (check.stroke or check.riding):
             return f"state {check.deviation:.2g} of its tolerances from the reference"
         return None
 
@@ -133,16 +138,21 @@ class PushWatch:
     """The push from outside, read after each whole-body QP from its centre-of-mass
     velocity and contact forces (:class:`~ridempc.mpc.impulse.ImpulseObserver`): a tick
     observer (of ``wbc_observers``) and a trigger; the observer's window restarts while the
-    backup rides (its forces are not the QP's).
+    backup rides (its forces are not the QP's). ``riding``: a push read inside the band,
+    from the pair's ``ride_floor`` of it (:mod:`~ridempc.mpc.push_ride`).
 
     Args:
         observer: The impulse observer.
         trigger: The pair's impulse band.
+        ride_floor: The band's share from which a push is ridden out [-] (None: never).
     """
 
-    def __init__(self, observer: ImpulseObserver, trigger: ImpulseTrigger) -> None:
-        self.observer, self._trigger = observer, trigger
+    def __init__(
+        self, observer: ImpulseObserver, trigger: ImpulseTrigger, ride_floor: float | None = None
+    ) -> None:
+        self.observer, self._trigger, self.ride_floor = observer, trigger, ride_floor
         self.reason: str | None = None
+        self.riding = False
 
     @classmethod
     def of(cls, stage: ImpulseStage | None, mass: float) -> PushWatch | None:
@@ -150,12 +160,13 @@ class PushWatch:
         [kg], as modelled; None without it."""
         if stage is None:
             return None
-        return cls(ImpulseObserver(mass), ImpulseTrigger(stage.band, stage.sideways))
+        trigger = ImpulseTrigger(stage.band, stage.sideways)
+        return cls(ImpulseObserver(mass), trigger, stage.ride_floor)
 
     def observe(self, tick: ControlTick) -> None:
         if tick.on_backup:
             self.observer.reset()
-            self.reason = None
+            self.reason, self.riding = None, False
             return
         out = tick.wbc
         assert out is not None  # after the whole-body QP
@@ -164,6 +175,10 @@ class PushWatch:
         estimate = tick.estimate
         heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
         self.reason = self._trigger(impulse, heading)
+        if self.ride_floor is not None:
+            trigger = self._trigger
+            share = band_share(impulse, heading, trigger.band, trigger.sideways)
+            self.riding = rides_push(share, self.ride_floor)
 
     def __call__(self, check: HandoverCheck) -> str | None:
         """Why the push is beyond what the MPC rides, or None."""
