@@ -12,13 +12,17 @@ over then contradicts the band: the backup inherits a rider mid-recovery, with t
 contact forces at the plan's and the trunk moving, rather than a push it could ride from
 the start.
 
-So while the impulse observer reads a push inside the band, the deviation's handover
-waits; it is judged again once the push has left the observer's window
-(:data:`~ridempc.mpc.impulse.WINDOW_S` after it), and a failed plan, a whole-body QP on
-slack or a push beyond the band still hand over at once. A pair opts in with ``[stages.impulse]
-ride_floor``: the share of the band's ellipse (:math:`r` below) from which a reading counts
-as a push rather than the observer's idle residual (its noise and the rider's own
-unmodelled forces).
+So from the tick the impulse observer reads a push inside the band, the deviation's
+handover waits until the rider has settled again (its deviation back within
+:data:`~ridempc.mpc.handover.RETURN_DEVIATION`, the band in which the MPC may take a ride
+back): the recovery takes longer than the push's 0.4 s in the observer's window
+(:data:`~ridempc.mpc.impulse.WINDOW_S`; deferred only while the push was in it, Go1 `hard`
+seed 181 v0025 was handed over 0.48 s after its push, at 3.9, and the handed PD fell,
+where the MPC alone rides it). A failed plan, a whole-body QP on slack or a push beyond
+the band still hand over at once. A pair opts in with ``[stages.impulse] ride_floor``:
+the share of the band's ellipse (:math:`r` below) from which a reading counts as a push
+rather than the observer's idle residual (its noise and the rider's own unmodelled
+forces).
 """
 
 from __future__ import annotations
@@ -28,7 +32,9 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["band_share", "rides_push"]
+from ridempc.mpc.handover import RETURN_DEVIATION
+
+__all__ = ["RideOut", "band_share", "rides_push"]
 
 
 def band_share(impulse: NDArray[np.float64], heading: float, band: float, sideways: float) -> float:
@@ -47,3 +53,29 @@ def rides_push(share: float, floor: float | None) -> bool:
     (:func:`band_share`) from the pair's ``floor`` [-] up to the band itself; never
     without a floor (the pair not opted in)."""
     return floor is not None and floor <= share <= 1.0
+
+
+class RideOut:
+    """The deviation's handover deferred from a push read inside the band until the
+    rider has settled (see the module docstring).
+
+    Args:
+        floor: The pair's ``ride_floor`` [-].
+    """
+
+    def __init__(self, floor: float) -> None:
+        self.floor = floor
+        self.active = False
+
+    def reset(self) -> None:
+        """Nothing ridden out (the backup rides)."""
+        self.active = False
+
+    def update(self, share: float, deviation: float) -> bool:
+        """Whether the deviation's handover waits this tick, with the push read at
+        ``share`` of the band and the state at ``deviation`` [-] of its reference."""
+        if rides_push(share, self.floor):
+            self.active = True
+        elif share > 1.0 or deviation <= RETURN_DEVIATION:
+            self.active = False
+        return self.active

@@ -30,7 +30,7 @@ from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION, LEAD_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
-from ridempc.mpc.push_ride import band_share, rides_push
+from ridempc.mpc.push_ride import RideOut, band_share
 from ridempc.mpc.stages.base import ControlTick, present
 from ridempc.pair_description import ImpulseStage
 
@@ -138,8 +138,8 @@ class PushWatch:
     """The push from outside, read after each whole-body QP from its centre-of-mass
     velocity and contact forces (:class:`~ridempc.mpc.impulse.ImpulseObserver`): a tick
     observer (of ``wbc_observers``) and a trigger; the observer's window restarts while the
-    backup rides (its forces are not the QP's). ``riding``: a push read inside the band,
-    from the pair's ``ride_floor`` of it (:mod:`~ridempc.mpc.push_ride`).
+    backup rides (its forces are not the QP's). With the pair's ``ride_floor``, a push read
+    inside the band is ridden out (:meth:`rides_out`, :mod:`~ridempc.mpc.push_ride`).
 
     Args:
         observer: The impulse observer.
@@ -150,9 +150,10 @@ class PushWatch:
     def __init__(
         self, observer: ImpulseObserver, trigger: ImpulseTrigger, ride_floor: float | None = None
     ) -> None:
-        self.observer, self._trigger, self.ride_floor = observer, trigger, ride_floor
+        self.observer, self._trigger = observer, trigger
         self.reason: str | None = None
-        self.riding = False
+        self.share = 0.0  # [-] the push's share of the band (push_ride.band_share)
+        self.ride_out = RideOut(ride_floor) if ride_floor is not None else None
 
     @classmethod
     def of(cls, stage: ImpulseStage | None, mass: float) -> PushWatch | None:
@@ -166,7 +167,9 @@ class PushWatch:
     def observe(self, tick: ControlTick) -> None:
         if tick.on_backup:
             self.observer.reset()
-            self.reason, self.riding = None, False
+            self.reason, self.share = None, 0.0
+            if self.ride_out is not None:
+                self.ride_out.reset()
             return
         out = tick.wbc
         assert out is not None  # after the whole-body QP
@@ -175,14 +178,16 @@ class PushWatch:
         estimate = tick.estimate
         heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
         self.reason = self._trigger(impulse, heading)
-        if self.ride_floor is not None:
-            trigger = self._trigger
-            share = band_share(impulse, heading, trigger.band, trigger.sideways)
-            self.riding = rides_push(share, self.ride_floor)
+        self.share = band_share(impulse, heading, self._trigger.band, self._trigger.sideways)
 
     def __call__(self, check: HandoverCheck) -> str | None:
         """Why the push is beyond what the MPC rides, or None."""
         return self.reason
+
+    def rides_out(self, deviation: float) -> bool:
+        """Whether a push inside the band defers the deviation's handover this tick, with
+        the state at ``deviation`` [-] of its reference (never without a ``ride_floor``)."""
+        return self.ride_out is not None and self.ride_out.update(self.share, deviation)
 
 
 def handover_triggers(
