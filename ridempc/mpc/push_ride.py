@@ -12,17 +12,18 @@ over then contradicts the band: the backup inherits a rider mid-recovery, with t
 contact forces at the plan's and the trunk moving, rather than a push it could ride from
 the start.
 
-So from the tick the impulse observer reads a push inside the band, the deviation's
-handover waits until the rider has settled again (its deviation back within
-:data:`~ridempc.mpc.handover.RETURN_DEVIATION`, the band in which the MPC may take a ride
-back): the recovery takes longer than the push's 0.4 s in the observer's window
-(:data:`~ridempc.mpc.impulse.WINDOW_S`; deferred only while the push was in it, Go1 `hard`
-seed 181 v0025 was handed over 0.48 s after its push, at 3.9, and the handed PD fell,
-where the MPC alone rides it). A failed plan, a whole-body QP on slack or a push beyond
-the band still hand over at once. A pair opts in with ``[stages.impulse] ride_floor``:
-the share of the band's ellipse (:math:`r` below) from which a reading counts as a push
-rather than the observer's idle residual (its noise and the rider's own unmodelled
-forces).
+So a push read inside the band while the state is still within the handover's bound
+starts a ride-out: the deviation's handover waits until the push has left the observer's
+window and the state is back within the bound (the excursion the push made is over; a
+deviation beyond the bound after that is the MPC's own, and hands over as before). The
+recovery may take longer than the push's 0.4 s in the window
+(:data:`~ridempc.mpc.impulse.WINDOW_S`): on the Go1 (`hard` seed 181 v0025, a 2.9 N/kg
+push for 0.14 s) the deviation stayed at 3.7-4.0 for a second after the push and came
+back within 3.0 1.2 s after it; handed over at the window's end the PD fell, ridden out the
+MPC stood. A failed plan, a whole-body QP on slack or a push beyond the band still hand
+over at once. A pair opts in with ``[stages.impulse] ride_floor``: the share of the band's
+ellipse (:math:`r` below) from which a reading counts as a push rather than the observer's
+residual between pushes (its noise and the rider's own unmodelled forces).
 """
 
 from __future__ import annotations
@@ -31,8 +32,6 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-
-from ridempc.mpc.handover import RETURN_DEVIATION
 
 __all__ = ["RideOut", "band_share", "rides_push"]
 
@@ -56,15 +55,16 @@ def rides_push(share: float, floor: float | None) -> bool:
 
 
 class RideOut:
-    """The deviation's handover deferred from a push read inside the band until the
-    rider has settled (see the module docstring).
+    """The deviation's handover deferred over a push's excursion (see the module
+    docstring).
 
     Args:
         floor: The pair's ``ride_floor`` [-].
+        bound: The pair's handover deviation [-] (``[mpc] handover_deviation``).
     """
 
-    def __init__(self, floor: float) -> None:
-        self.floor = floor
+    def __init__(self, floor: float, bound: float) -> None:
+        self.floor, self.bound = floor, bound
         self.active = False
 
     def reset(self) -> None:
@@ -73,9 +73,11 @@ class RideOut:
 
     def update(self, share: float, deviation: float) -> bool:
         """Whether the deviation's handover waits this tick, with the push read at
-        ``share`` of the band and the state at ``deviation`` [-] of its reference."""
-        if rides_push(share, self.floor):
-            self.active = True
-        elif share > 1.0 or deviation <= RETURN_DEVIATION:
-            self.active = False
+        ``share`` of the band and the state at ``deviation`` [-] of its reference: from a
+        push inside the band found with the state within the bound, while the push is read
+        or the state is beyond the bound."""
+        if self.active:
+            self.active = share <= 1.0 and (share >= self.floor or deviation > self.bound)
+        else:
+            self.active = rides_push(share, self.floor) and deviation <= self.bound
         return self.active

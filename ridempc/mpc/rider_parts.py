@@ -274,7 +274,8 @@ class RiderParts(Controller):
         self.solver = PlanSolver(latency, self._build_and_run, self._build_in_process)
         self._diagnostics: dict[str, float] = {}
         # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
-        self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass)
+        bound = self.pair.description.mpc.handover_deviation
+        self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass, bound)
         self.impulse = self.push_watch.observer if self.push_watch is not None else None
         self.payload_models = (
             PayloadModels(

@@ -144,25 +144,29 @@ class PushWatch:
     Args:
         observer: The impulse observer.
         trigger: The pair's impulse band.
-        ride_floor: The band's share from which a push is ridden out [-] (None: never).
+        ride_out: The pair's ride-out of a push inside the band (None: none).
     """
 
     def __init__(
-        self, observer: ImpulseObserver, trigger: ImpulseTrigger, ride_floor: float | None = None
+        self, observer: ImpulseObserver, trigger: ImpulseTrigger, ride_out: RideOut | None = None
     ) -> None:
         self.observer, self._trigger = observer, trigger
         self.reason: str | None = None
         self.share = 0.0  # [-] the push's share of the band (push_ride.band_share)
-        self.ride_out = RideOut(ride_floor) if ride_floor is not None else None
+        self.ride_out = ride_out
 
     @classmethod
-    def of(cls, stage: ImpulseStage | None, mass: float) -> PushWatch | None:
-        """With the pair's ``impulse`` stage (its bands), the watch of a rider of ``mass``
-        [kg], as modelled; None without it."""
+    def of(
+        cls, stage: ImpulseStage | None, mass: float, bound: float = HANDOVER_DEVIATION
+    ) -> PushWatch | None:
+        """With the pair's ``impulse`` stage (its bands, its ``ride_floor``), the watch of a
+        rider of ``mass`` [kg], as modelled, handed over beyond ``bound`` [-] of its
+        reference; None without it."""
         if stage is None:
             return None
         trigger = ImpulseTrigger(stage.band, stage.sideways)
-        return cls(ImpulseObserver(mass), trigger, stage.ride_floor)
+        floor = stage.ride_floor
+        return cls(ImpulseObserver(mass), trigger, RideOut(floor, bound) if floor else None)
 
     def observe(self, tick: ControlTick) -> None:
         if tick.on_backup:
