@@ -248,15 +248,6 @@ class FlightStage(_Frozen):
 class ImpulseStage(_Frozen):
     band: Speed = Field(description="Largest unexplained velocity change the MPC rides [m/s].")
     sideways: Speed | None = Field(default=None, description="The same across it [m/s].")
-    ride_floor: float | None = Field(
-        default=None,
-        gt=0.0,
-        lt=1.0,
-        description=(
-            "Share of the band from which a push's reading defers the deviation's handover "
-            "(mpc/push_ride.py) [-]; none: never deferred."
-        ),
-    )
 
 
 class Stages(_Frozen):

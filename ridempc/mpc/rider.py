@@ -221,7 +221,6 @@ class MpcRider(RiderReports):
             stroke,
             self.watch.probation.proven,
             self.watch.divergence,
-            self.push_watch is not None and self.push_watch.rides_out(self.book.deviation),
         )
         for trigger in self.triggers:  # the first reason hands the ride over
             reason = trigger(check)

@@ -274,8 +274,7 @@ class RiderParts(Controller):
         self.solver = PlanSolver(latency, self._build_and_run, self._build_in_process)
         self._diagnostics: dict[str, float] = {}
         # a push the MPC cannot ride handed to the backup at once (mpc/impulse.py)
-        bound = self.pair.description.mpc.handover_deviation
-        self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass, bound)
+        self.push_watch = PushWatch.of(stages.impulse, self.wbc.model.mass)
         self.impulse = self.push_watch.observer if self.push_watch is not None else None
         self.payload_models = (
             PayloadModels(

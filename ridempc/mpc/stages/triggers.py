@@ -12,8 +12,7 @@ backup law (:mod:`~ridempc.mpc.handover`):
    (:mod:`~ridempc.mpc.impulse`; with the ``impulse`` stage);
 5. :class:`Deviated`: the state beyond the pair's ``[mpc] handover_deviation`` (default
    :data:`~ridempc.mpc.handover.HANDOVER_DEVIATION`) of
-   its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`; so
-   does a push inside the impulse band where the pair says so, :mod:`~ridempc.mpc.push_ride`);
+   its reference (a re-push's stroke rides out, :mod:`~ridempc.mpc.push_handover`);
 6. :func:`diverging`: or heading beyond :data:`~ridempc.mpc.handover.LEAD_DEVIATION` within a
    divergence time, until the MPC has held the rider settled (:mod:`~ridempc.mpc.divergence`).
 """
@@ -30,7 +29,6 @@ from ridempc.mpc.drop import DropDetector
 from ridempc.mpc.handover import HANDOVER_DEVIATION, LEAD_DEVIATION
 from ridempc.mpc.impulse import ImpulseObserver, ImpulseTrigger
 from ridempc.mpc.plan import Plan
-from ridempc.mpc.push_ride import RideOut, band_share
 from ridempc.mpc.stages.base import ControlTick, present
 from ridempc.pair_description import ImpulseStage
 
@@ -51,9 +49,8 @@ __all__ = [
 class HandoverCheck(NamedTuple):
     """What the triggers read after a tick's whole-body QP: the plan in force, the QP's
     slack, the state's deviation from its reference [-], whether a re-push's stroke defers
-    it, whether the MPC has proven itself since the start or its return, the
-    deviation's divergence, and whether a push inside the impulse band defers the
-    deviation (:mod:`~ridempc.mpc.push_ride`)."""
+    it, whether the MPC has proven itself since the start or its return, and the
+    deviation's divergence."""
 
     plan: Plan
     slack: float
@@ -61,7 +58,6 @@ class HandoverCheck(NamedTuple):
     stroke: bool
     proven: bool
     divergence: DivergentDeviation
-    riding: bool = False
 
 
 class HandoverTrigger(Protocol):
@@ -83,14 +79,13 @@ def needs_slack(check: HandoverCheck) -> str | None:
 
 class Deviated:
     """The state beyond ``bound`` [-] of its reference, in its tolerances (unless a
-    re-push's stroke or a push ridden inside the band defers it); the pair's ``[mpc]
-    handover_deviation``."""
+    re-push's stroke defers it); the pair's ``[mpc] handover_deviation``."""
 
     def __init__(self, bound: float = HANDOVER_DEVIATION) -> None:
         self.bound = bound
 
     def __call__(self, check: HandoverCheck) -> str | None:
-        if check.deviation > self.bound and not (check.stroke or check.riding):
+        if check.deviation > self.bound and not check.stroke:
             return f"state {check.deviation:.2g} of its tolerances from the reference"
         return None
 
@@ -138,42 +133,29 @@ class PushWatch:
     """The push from outside, read after each whole-body QP from its centre-of-mass
     velocity and contact forces (:class:`~ridempc.mpc.impulse.ImpulseObserver`): a tick
     observer (of ``wbc_observers``) and a trigger; the observer's window restarts while the
-    backup rides (its forces are not the QP's). With the pair's ``ride_floor``, a push read
-    inside the band is ridden out (:meth:`rides_out`, :mod:`~ridempc.mpc.push_ride`).
+    backup rides (its forces are not the QP's).
 
     Args:
         observer: The impulse observer.
         trigger: The pair's impulse band.
-        ride_out: The pair's ride-out of a push inside the band (None: none).
     """
 
-    def __init__(
-        self, observer: ImpulseObserver, trigger: ImpulseTrigger, ride_out: RideOut | None = None
-    ) -> None:
+    def __init__(self, observer: ImpulseObserver, trigger: ImpulseTrigger) -> None:
         self.observer, self._trigger = observer, trigger
         self.reason: str | None = None
-        self.share = 0.0  # [-] the push's share of the band (push_ride.band_share)
-        self.ride_out = ride_out
 
     @classmethod
-    def of(
-        cls, stage: ImpulseStage | None, mass: float, bound: float = HANDOVER_DEVIATION
-    ) -> PushWatch | None:
-        """With the pair's ``impulse`` stage (its bands, its ``ride_floor``), the watch of a
-        rider of ``mass`` [kg], as modelled, handed over beyond ``bound`` [-] of its
-        reference; None without it."""
+    def of(cls, stage: ImpulseStage | None, mass: float) -> PushWatch | None:
+        """With the pair's ``impulse`` stage (its bands), the watch of a rider of ``mass``
+        [kg], as modelled; None without it."""
         if stage is None:
             return None
-        trigger = ImpulseTrigger(stage.band, stage.sideways)
-        floor = stage.ride_floor
-        return cls(ImpulseObserver(mass), trigger, RideOut(floor, bound) if floor else None)
+        return cls(ImpulseObserver(mass), ImpulseTrigger(stage.band, stage.sideways))
 
     def observe(self, tick: ControlTick) -> None:
         if tick.on_backup:
             self.observer.reset()
-            self.reason, self.share = None, 0.0
-            if self.ride_out is not None:
-                self.ride_out.reset()
+            self.reason = None
             return
         out = tick.wbc
         assert out is not None  # after the whole-body QP
@@ -182,16 +164,10 @@ class PushWatch:
         estimate = tick.estimate
         heading = estimate.boards[0].yaw if estimate.boards else estimate.yaw
         self.reason = self._trigger(impulse, heading)
-        self.share = band_share(impulse, heading, self._trigger.band, self._trigger.sideways)
 
     def __call__(self, check: HandoverCheck) -> str | None:
         """Why the push is beyond what the MPC rides, or None."""
         return self.reason
-
-    def rides_out(self, deviation: float) -> bool:
-        """Whether a push inside the band defers the deviation's handover this tick, with
-        the state at ``deviation`` [-] of its reference (never without a ``ride_floor``)."""
-        return self.ride_out is not None and self.ride_out.update(self.share, deviation)
 
 
 def handover_triggers(
