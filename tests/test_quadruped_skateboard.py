@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 
 from ridempc.baselines.quadruped_legs import QuadrupedLegs
-from ridempc.baselines.quadruped_skateboard import QuadrupedSkateboardPD
+from ridempc.baselines.quadruped_skateboard import QuadrupedSkateboardPD, _leg_solve
 from ridempc.baselines.quadruped_skateboard_gains import (
     DEFAULT_GAINS_FILE,
     load_quadruped_skateboard_gains,
@@ -72,6 +72,18 @@ def test_leg_jacobian_matches_finite_differences(dog, legs) -> None:
                 ]
             )
             np.testing.assert_allclose(leg.jacobian(q), numeric, atol=1e-8)
+
+
+def test_a_straight_legs_force_is_read_without_its_unloaded_direction() -> None:
+    """A leg with its knee read exactly straight: its Jacobian is singular (the hip's pitch
+    and the knee sweep the foot the same way); the load is read as the least-norm force,
+    nothing along the singular direction, rather than ending the ride."""
+    reach = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.5]])  # rank 2
+    torques = reach @ np.array([2.0, 0.0, 3.0])
+    force = _leg_solve(reach, torques)
+    np.testing.assert_allclose(reach @ force, torques, atol=1e-12)
+    np.testing.assert_allclose(force, [2.0, 1.2, 0.6], atol=1e-12)  # none along (0, 1, -2)
+    np.testing.assert_array_equal(_leg_solve(np.eye(3), torques), torques)
 
 
 def test_inverse_kinematics_inverts_the_forward(dog, legs) -> None:

@@ -110,7 +110,7 @@ from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
 from ridempc.errors import ConfigError
 from ridempc.estimation import EstimatedState, StateEstimator
-from ridempc.estimation.lapack import solve
+from ridempc.estimation.lapack import pinv, solve
 from ridempc.gravity import GRAVITY
 from ridempc.robots.pinocchio_model import build_pinocchio_robot
 from ridempc.robots.robot import Robot
@@ -135,6 +135,18 @@ def _limited_rotation(current: Array, wanted: Array, limit: float) -> Array:
     )
     axis *= limit / np.linalg.norm(axis)
     return exp3(axis) @ current
+
+
+def _leg_solve(a: Array, b: Array) -> Array:
+    """:math:`a^{-1} b` for a leg's 3 x 3 Jacobian (or its transpose); for a leg at a
+    singularity (the knee straight, read exactly so from the quantised encoders: the hip's
+    pitch and the knee move the foot the same way, and the foot's force along the leg loads
+    no joint), the least-norm solution :math:`a^+ b`, which leaves that direction at zero
+    rather than ending the ride (Go1 `hard` seed 193 v0008, standby under the MPC)."""
+    try:
+        return solve(a, b)
+    except np.linalg.LinAlgError:
+        return pinv(a) @ b
 
 
 def _row_mean(rows: Array) -> Array:
@@ -309,7 +321,7 @@ class QuadrupedSkateboardPD(Controller):
         com, leg_gravity = self.legs.com_and_gravity(q, rotation_fb)
         loads = np.empty(4)
         for i, joints in enumerate(self._leg_joints):
-            force_b = solve(jacobians[i].T, leg_gravity[joints] - tau[joints])
+            force_b = _leg_solve(jacobians[i].T, leg_gravity[joints] - tau[joints])
             loads[i] = float(rotation_fb[2] @ force_b)
         pressed = feet.copy()
         pressed[:, 2] += self.gains.contact.compliance * np.maximum(loads, 0.0)
@@ -510,7 +522,7 @@ class QuadrupedSkateboardPD(Controller):
             unreachable += not reachable
             position[joints] = q_leg
             relative = state.feet_velocity[i] - mean_velocity - origin_rate
-            velocity[joints] = solve(state.jacobians[i], rotation.T @ relative)
+            velocity[joints] = _leg_solve(state.jacobians[i], rotation.T @ relative)
             ground_force_b = state.trunk_rotation[2] * loads[i]  # R_FB^T (0, 0, f_i)
             torque[joints] = state.leg_gravity[joints] - state.jacobians[i].T @ ground_force_b
 
