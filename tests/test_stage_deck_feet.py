@@ -102,8 +102,6 @@ def test_the_roll_drift_is_held_on_a_light_side_and_restarts_off_balance() -> No
 
 
 class _Limit:
-    offset_per_roll, margin, time_constant = 0.42, 0.0, 0.5
-
     def __init__(self) -> None:
         self.last = (-0.01, 0.01)
         self.asked: list[Any] = []
@@ -140,25 +138,6 @@ def test_the_commanded_roll_is_held_within_the_four_feets_stance(yaw: float) -> 
     np.testing.assert_array_equal(stance(roll, lifted), [-0.01, 0.0, 0.01])
     np.testing.assert_array_equal(stance(roll, _tick(balancing=False)), roll)
     assert limit.resets == 1
-
-
-def test_a_steered_swing_holds_the_roll_within_the_three_feet_on_the_deck() -> None:
-    """Off balance and steering (a re-push's swing) with the right rear foot in the air,
-    the roll is held within what the three feet on the deck hold: towards the left, the
-    side that keeps both feet (:mod:`ridempc.mpc.stance_three`); with four feet down (a
-    stroke) or not steering (a push-off) it is as commanded."""
-    com = np.array([0.0, 0.0, 0.3])
-    stance = StanceRoll(cast(Any, _Limit()), _sides(), lambda estimate: com)
-    roll = np.array([-0.3, -0.1, 0.0, 0.1])
-    swing = _tick(balancing=False)
-    swing.estimate.contact[3] = False
-    held = stance(roll, swing, steering=True)
-    assert held[0] > -0.3 and held[1] == -0.1 and held[2] < 0.0 and held[3] == held[2]
-    low, high = swing.diagnostics["stance_low"], swing.diagnostics["stance_high"]
-    assert -0.3 < low < -0.1 < high < 0.0
-    np.testing.assert_array_equal(stance(roll, _tick(balancing=False), steering=True), roll)
-    np.testing.assert_array_equal(stance(roll, swing, steering=False), roll)
-    assert stance.three.level is None
 
 
 def _feet_targets(plans_feet: bool) -> tuple[FeetTargets, list[Any]]:

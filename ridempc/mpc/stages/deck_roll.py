@@ -9,9 +9,7 @@ Two feet on each side of the deck's centre line hold its roll. While the rider b
   least force: two feet on one fore-aft line do not see the deck's roll, and the estimate
   winds up;
 - :class:`StanceRoll`: the commanded deck roll held within what the four feet's estimated
-  stance can hold (:mod:`~ridempc.mpc.stance`); and, in a re-push's swing, when the rider
-  steers on three feet with the fourth in the air, within what those three hold
-  (:mod:`~ridempc.mpc.stance_three`).
+  stance can hold (:mod:`~ridempc.mpc.stance`).
 
 Both restart when the rider stops balancing (a push-off changes the stance).
 """
@@ -33,7 +31,6 @@ from ridempc.mpc.pairs import MpcPair
 from ridempc.mpc.roll_observer import RollObserver
 from ridempc.mpc.stages.base import MpcTick
 from ridempc.mpc.stance import StanceLimit
-from ridempc.mpc.stance_three import ThreeFootLimit
 from ridempc.trajopt.skateboard import skateboard_model
 
 __all__ = [
@@ -122,8 +119,7 @@ class RollDrift:
 class StanceRoll:
     """The commanded deck roll held within what the stance can hold, in four-leg
     balancing, from the four feet's estimated places (the last bounds while one is off the
-    deck); in a re-push's steered swing, within what the three feet on the deck hold; as
-    commanded elsewhere (module docstring).
+    deck); as commanded elsewhere (module docstring).
 
     Args:
         limit: The stance's limit.
@@ -135,22 +131,16 @@ class StanceRoll:
         self, limit: StanceLimit, sides: DeckSides, com: Callable[[EstimatedState], Array]
     ) -> None:
         self.limit, self._sides, self._com = limit, sides, com
-        self.three = ThreeFootLimit(limit.offset_per_roll, limit.margin, limit.time_constant)
 
-    def __call__(self, roll: Array, tick: MpcTick, steering: bool = False) -> Array:
-        """``roll`` [rad] at the horizon's nodes, held within the stance's bounds
-        (``steering``: whether the deck's roll steers, as in a re-push's swing)."""
+    def __call__(self, roll: Array, tick: MpcTick) -> Array:
+        """``roll`` [rad] at the horizon's nodes, held within the stance's bounds."""
         limit, estimate = self.limit, tick.estimate
         board = estimate.board
         if board is None:
             return roll
         if not tick.balancing:
             limit.reset()
-            if steering:
-                return self._three_feet(roll, tick)
-            self.three.reset()
             return roll
-        self.three.reset()
         side = self._sides.side
         feet = np.asarray(estimate.foot_position, dtype=float)
         four = bool(side) and len(feet) == 2 * side
@@ -163,26 +153,6 @@ class StanceRoll:
         far_share = 2.0 * self._sides.least_force() / self._sides.weight
         dt = tick.now - tick.plan_time
         low, high = limit.bounds(places, offset, float(board.roll), dt, far_share)
-        tick.diagnostics.update(stance_low=low, stance_high=high)
-        return np.clip(roll, low, high)
-
-    def _three_feet(self, roll: Array, tick: MpcTick) -> Array:
-        """``roll`` held within the three feet's bounds where exactly one of a two-sided
-        stance's feet is judged off the deck (a swing), as commanded otherwise."""
-        estimate, side = tick.estimate, self._sides.side
-        feet = np.asarray(estimate.foot_position, dtype=float)
-        contact = np.asarray(estimate.contact, dtype=bool)
-        board = estimate.board
-        if board is None or not side or len(feet) != 2 * side or int(contact.sum()) != 3:
-            self.three.reset()
-            return roll
-        on_deck = feet[contact, :2]
-        centre = on_deck.mean(axis=0)
-        places = to_deck(board.yaw, on_deck - centre)
-        offset = to_deck(board.yaw, self._com(estimate)[:2] - centre)
-        share = self._sides.least_force() / self._sides.weight
-        dt = tick.now - tick.plan_time
-        low, high = self.three.bounds(places, offset, float(board.roll), dt, share)
         tick.diagnostics.update(stance_low=low, stance_high=high)
         return np.clip(roll, low, high)
 

@@ -95,8 +95,7 @@ class CommandedFrame:
         whether the deck's roll may steer (the rider balancing, or re-pushing off the
         ground)."""
         now, speed = tick.now, tick.speed
-        stance = self.stance_roll
-        limit = partial(stance, tick=tick, steering=steering) if stance is not None else None
+        limit = partial(self.stance_roll, tick=tick) if self.stance_roll is not None else None
         names = self.layout.names
         roll, turn = self.commands.roll_and_turn(command, now, speed, steering, limit, names)
         here = self.mpc.reference.states_at(np.array([t_ref]))[0]  # the reference at t_ref
