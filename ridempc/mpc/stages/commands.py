@@ -22,7 +22,6 @@ from ridempc.boards.skateboard.steering import RollSteering
 from ridempc.controllers.base import Controller
 from ridempc.mpc.controller import MpcSettings
 from ridempc.mpc.manoeuvre import ManoeuvreSelector
-from ridempc.mpc.steer_speed import SteerSpeed
 from ridempc.scenarios.scenario import Command, Scenario
 
 __all__ = ["CommandHorizon"]
@@ -64,8 +63,6 @@ class CommandHorizon:
         self._speed_preview = speed_preview
         # a yaw-rate command steered by the deck's roll, eq. (14) inverted
         self.roll_steering = RollSteering(gain=steer_gain) if steer_gain is not None else None
-        # steered on through the speed's noise about the least speed (mpc/steer_speed.py)
-        self._steer_speed = SteerSpeed(self.roll_steering.min_speed) if self.roll_steering else None
         self._command_roll: tuple[float, float] | None = None
 
     def roll_horizon(self, command: Command, now: float) -> Array:
@@ -89,18 +86,16 @@ class CommandHorizon:
     def steering_roll(self, command: Command, now: float, speed: float) -> Array:
         """The deck roll that steers the commanded yaw rate at the horizon's nodes [rad]
         (:class:`~ridempc.boards.skateboard.steering.RollSteering`, at the board's speed
-        :math:`v` [m/s], held at the least speed through its noise band once steering,
-        :mod:`~ridempc.mpc.steer_speed`), each read the pair's ``roll_lead`` ahead as the
-        commanded roll is; zero on a board that does not steer by its roll."""
+        :math:`v` [m/s]), each read the pair's ``roll_lead`` ahead as the commanded roll
+        is; zero on a board that does not steer by its roll."""
         settings = self._settings
-        if self.roll_steering is None or self._steer_speed is None:
+        if self.roll_steering is None:
             return np.zeros(settings.horizon + 1)
         times = now + self._roll_lead + settings.dt * np.arange(settings.horizon + 1)
         rates = self.planned("yaw_rate", times)
         if rates is None:
             rates = np.full(len(times), float(command.yaw_rate))
-        steered = self._steer_speed(speed)
-        return np.array([self.roll_steering.roll(float(w), steered) for w in rates])
+        return np.array([self.roll_steering.roll(float(w), speed) for w in rates])
 
     def roll_turn(self, roll: Array, speed: float, names: dict[str, int]) -> Array:
         """The turn a commanded deck roll steers, over the horizon's steps [rad/s]: on the
