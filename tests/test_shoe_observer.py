@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from ridempc.boards import load_board
 from ridempc.estimation.state import BoardEstimate
 from ridempc.mpc.rider import MpcRider
 from ridempc.mpc.shoe_observer import LIMIT, ShoeObserver
+from ridempc.mpc.slope import SlopeEstimator
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
 from ridempc.sim.clock import DEFAULT_PHYSICS_HZ
@@ -31,12 +33,18 @@ def shoes() -> HovershoesBoard:
 
 
 def _ride_shoes(
-    shoes: HovershoesBoard, offsets: list[float], drags: list[float], seconds: float
+    shoes: HovershoesBoard,
+    offsets: list[float],
+    drags: list[float],
+    seconds: float,
+    ground: Callable[[float], tuple[float, float]] | None = None,
 ) -> list[tuple[float, np.ndarray, np.ndarray]]:
     """Two shoes heading 0.3 rad left, each under one foot ``offsets`` [m] ahead of its
     axis, integrated by eq. (4) and (8) with a drag ``drags`` [N] while the rider rocks its
     centre of pressure and pushes (forces at 1.3-2.9 Hz); fed to a fresh observer tick by
-    tick. Returns (time, offsets, drag) after each tick."""
+    tick. ``ground(t)``: the slope [rad] under both shoes, which also pulls them, as the
+    observer's slope estimate reads it, and a drag [N] added to ``drags`` there. Returns
+    (time, offsets, drag) after each tick."""
     p, m = shoes.reduced, shoes.shoe_mass
     observer = ShoeObserver(shoes, [0, 0, 1, 1])
     yaw = 0.3
@@ -69,10 +77,14 @@ def _ride_shoes(
                 )
             )
             theta_ddot = (-p.c1 * theta[k] - p.c2 * theta_dot[k] + torque) / p.J_theta
-            speed_dot = (p.c4 * theta[k] + push + drags[k]) / m
+            slope, more = (0.0, 0.0) if ground is None else ground(t)
+            pull = SlopeEstimator.gravity_drag(slope, m, load)
+            speed_dot = (p.c4 * theta[k] + push + drags[k] + more + pull) / m
             theta_dot[k] += DT * theta_ddot
             theta[k] += DT * theta_dot[k]
             speed[k] += DT * speed_dot
+        if ground is not None:  # the shoes stand where they are: the estimate holds this
+            observer.slopes.angles = [ground(t)[0]] * 2
         observer.update(board_estimate(t, tuple(boards)), np.array(positions), np.array(forces))
         out.append((t, observer.offsets.copy(), observer.drag.copy()))
     return out
@@ -90,6 +102,21 @@ def test_finds_where_the_feet_stand_and_the_drag_from_the_shoes_balances(shoes) 
     _, late, drag = history[-1]
     np.testing.assert_allclose(late, offsets, atol=0.001)
     np.testing.assert_allclose(drag, drags, atol=0.3)
+
+
+def test_the_drag_fitted_on_a_slope_is_forgotten_at_its_foot(shoes) -> None:
+    """Down 13 deg with 19 N more than the slope's pull (what the fit settles at under Cassie,
+    seed 0), then level ground with none: 0.5 s past the foot the drag is within 3 N of the
+    level ground's, where a fit that forgot only over its second still held 12 N."""
+
+    def ground(t: float) -> tuple[float, float]:
+        return (math.radians(-13.0), 19.0) if t < 2.0 else (0.0, 0.0)
+
+    history = _ride_shoes(shoes, [0.0, 0.0], [-2.0, -2.0], 2.5, ground)
+    on_slope = next(d for t, _, d in history if t >= 1.99)
+    pull = SlopeEstimator.gravity_drag(math.radians(-13.0), shoes.shoe_mass, 160.0)
+    np.testing.assert_allclose(on_slope, pull + 17.0, atol=6.0)
+    np.testing.assert_allclose(history[-1][2], [-2.0, -2.0], atol=3.0)
 
 
 def test_moves_the_mpc_shoes_behind_their_feet_and_adds_the_drag(shoes) -> None:

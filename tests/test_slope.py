@@ -12,7 +12,7 @@ from ridempc.boards import load_board
 from ridempc.estimation import EstimatedState
 from ridempc.estimation.state import BoardEstimate
 from ridempc.mpc.rider import MpcRider
-from ridempc.mpc.slope import GRAVITY, SlopeEstimator
+from ridempc.mpc.slope import GRAVITY, WINDOW, SlopeEstimator
 from ridempc.mpc.state_map import PlanarFrame
 from ridempc.robots import load_robot
 from ridempc.scenarios import resolve_scenario
@@ -21,28 +21,74 @@ from ridempc.sim.scene import build_scene
 from ridempc.sim.simulation import Simulation
 
 
-def _board(speed: float, angle_deg: float, yaw: float = 0.0, z: float = 0.0) -> BoardEstimate:
+def _board(position: np.ndarray, speed: float, angle_deg: float, yaw: float = 0.0) -> BoardEstimate:
     a = math.radians(angle_deg)
     velocity = speed * np.array(
         [math.cos(a) * math.cos(yaw), math.cos(a) * math.sin(yaw), math.sin(a)]
     )
-    return BoardEstimate(("f",), np.array([0.0, 0.0, z]), yaw, 0.0, 0.0, velocity, 0.0)
+    return BoardEstimate(("f",), position.copy(), yaw, 0.0, 0.0, velocity, 0.0)
 
 
-@pytest.mark.parametrize(("speed", "yaw"), [(0.5, 0.0), (0.5, 1.0), (-0.5, 0.3)])
-def test_the_slope_is_read_off_the_platforms_velocity(speed: float, yaw: float) -> None:
-    slopes = SlopeEstimator(1)
-    for k in range(200):  # 2 s at 100 Hz on ground rising 7 deg ahead (backing: down it)
-        slopes.update(0.01 * k, [_board(speed, 7.0, yaw)])
-    assert math.degrees(slopes.angles[0]) == pytest.approx(7.0, abs=0.05)
+def _roll(
+    slopes: SlopeEstimator, ground: list[tuple[float, float]], speed: float, yaw: float = 0.0
+) -> list[float]:
+    """Roll one platform at ``speed`` [m/s] (negative: backing) over ``ground``, (seconds,
+    slope [deg]) pieces in turn, ticks of 2 ms with a millimetre of noise on its height;
+    returns the estimate [deg] after each tick."""
+    rng = np.random.default_rng(3)
+    position, t, out = np.zeros(3), 0.0, []
+    heading = np.array([math.cos(yaw), math.sin(yaw), 0.0])
+    for seconds, angle in ground:
+        for _ in range(round(seconds / 0.002)):
+            a = math.radians(angle)
+            position = position + 0.002 * speed * (math.cos(a) * heading + [0, 0, math.sin(a)])
+            noisy = position + [0.0, 0.0, 0.001 * rng.standard_normal()]
+            t += 0.002
+            slopes.update(t, [_board(noisy, speed, angle, yaw)])
+            out.append(math.degrees(slopes.angles[0]))
+    return out
+
+
+@pytest.mark.parametrize(("speed", "yaw"), [(0.5, 0.0), (0.5, 1.0), (-0.5, 0.3), (0.05, 0.0)])
+def test_the_slope_is_read_off_the_height_lost_over_the_distance_rolled(
+    speed: float, yaw: float
+) -> None:
+    """Ground rising 7 deg ahead (backing: down it), at a walking pace and at 5 cm/s."""
+    read = _roll(SlopeEstimator(1), [(0.6 / abs(speed), 7.0)], speed, yaw)
+    assert read[-1] == pytest.approx(7.0, abs=0.7)
+
+
+def test_the_slopes_foot_reads_level_within_a_window_rolled_however_slowly() -> None:
+    """Down 13 deg, then level ground crept over at 0.1 m/s: level (within 1 deg) once
+    the platform has rolled the window past the foot, 1.5 s, where a speed-gated estimate
+    would have held the slope."""
+    slow = 0.1  # [m/s]
+    read = _roll(SlopeEstimator(1), [(4.0, -13.0), (2.0 * WINDOW / slow, 0.0)], slow)
+    at_foot = round(4.0 / 0.002)
+    assert read[at_foot - 1] == pytest.approx(-13.0, abs=1.0)
+    past = at_foot + round(1.05 * WINDOW / slow / 0.002)
+    assert max(abs(r) for r in read[past:]) < 1.0
 
 
 def test_steps_and_standing_still_leave_the_slope_alone() -> None:
+    """A drop of 3.5 cm off a step's edge (at 0.7 m/s down, 80 deg) between level
+    ground: the estimate never reads the drop; standing still, it holds what it read."""
     slopes = SlopeEstimator(1)
-    slopes.update(0.0, [_board(0.5, 0.0)])
-    slopes.update(0.1, [_board(0.6, -60.0)])  # dropping off a step
-    slopes.update(0.2, [_board(0.05, 45.0)])  # standing: the direction is noise
-    assert slopes.angles == [0.0]
+    read = _roll(slopes, [(1.0, 0.0)], 0.5)
+    position = np.zeros(3)
+    for k in range(25):  # the fall: 3.5 cm in 50 ms
+        position = position + [0.001, 0.0, -0.0014]
+        slopes.update(1.0 + 0.002 * k, [_board(position, 0.71, -80.0)])
+        read.append(math.degrees(slopes.angles[0]))
+    read += _roll(slopes, [(1.0, 0.0)], 0.5)
+    assert max(abs(r) for r in read) < 1.0
+    slopes.angles[0] = before = math.radians(7.0)  # as if it had stood on 7 deg
+    last = slopes._last[0]
+    assert last is not None
+    for k in range(200):  # standing, the sensors bobbing by a millimetre
+        bob = np.array(last) + [0.0, 0.0, 0.001 * math.sin(0.3 * k)]
+        slopes.update(3.0 + 0.002 * k, [_board(bob, 0.0, 0.0)])
+    assert slopes.angles[0] == before
     drag = SlopeEstimator.gravity_drag(math.radians(7.0), 2.7, 170.0)
     assert drag == pytest.approx(-(2.7 * GRAVITY + 170.0) * math.sin(math.radians(7.0)))
 

@@ -34,7 +34,14 @@ its shoes level at 0.5 m/s and the speed sagged to 0.35 m/s.
 
 **Slopes.** The ground's slope under each shoe, estimated from its velocity
 (:mod:`ridempc.mpc.slope`), adds its pull :math:`G = -(m_s g + N)\\sin\\hat\\alpha` to
-:math:`D` at once; the fit below finds only the rest.
+:math:`D` at once; the fit below finds only the rest. What the fit finds on one slope is not
+another's (down 13 deg it settles at +19 N, on level ground at -2 N, seed 0; and while the
+slope estimate moves, the fit takes in the pull the estimate has not yet read): each time
+the slope estimate under a shoe has moved ``SLOPE_CHANGE`` from where it was at the last such
+change, the shoe's drag fit forgets as if ``MEMORY`` had passed once per ``SLOPE_CHANGE`` of it
+(:math:`\\lambda = e^{-|\\Delta\\hat\\alpha| / \\alpha_c}`), so it is refitted on the new
+ground within a few tenths of a second rather than holding the old pull for a second (which
+held the shoes back at the slope's foot).
 
 **Fitting.** The pitch, the speed, the torque, the push and the load pass through the same
 critically damped second-order low-pass at ``FILTER_HZ``, whose states give the filtered
@@ -82,7 +89,7 @@ from ridempc.mpc.slope_trim import SlopeSpeedTrim
 from ridempc.mpc.state_map import forward_speed
 from ridempc.trajopt.platforms import HovershoesBoard
 
-__all__ = ["FILTER_HZ", "LIMIT", "MEMORY", "MIN_LOAD", "WARM_UP", "ShoeObserver"]
+__all__ = ["FILTER_HZ", "LIMIT", "MEMORY", "MIN_LOAD", "SLOPE_CHANGE", "WARM_UP", "ShoeObserver"]
 
 Array = NDArray[np.float64]
 FILTER_HZ: float = 4.0  # [Hz] natural frequency of the critically damped low-pass
@@ -90,6 +97,9 @@ LIMIT: float = 0.08  # [m] |d| at most: half of Cassie's toe line
 MIN_LOAD: float = 20.0  # [N] below this filtered load the offset is not updated
 MEMORY: float = 1.0  # [s] forgetting time of the least squares
 WARM_UP: float = 0.05  # [s] the low-pass settles from its first sample before it is fitted
+# [rad] a change of the ground under a shoe: the slope trim's gate (3 deg, ten times what the
+# slope estimate reads on level ground), so 13 deg forgets the old slope's drag four times over
+SLOPE_CHANGE: float = math.radians(3.0)
 
 
 class _SecondOrder:
@@ -150,6 +160,7 @@ class ShoeObserver:
         self.offsets = np.zeros(n)  # [m] d per platform
         self.drag = np.zeros(n)  # [N] D per platform
         self.slopes = SlopeEstimator(n)  # the ground's slope under each shoe
+        self._fitted_on = [0.0] * n  # [rad] the slope at the drag fit's last forgetting
         self.trim = SlopeSpeedTrim()  # the reference's speed trim on a slope (mpc/slope_trim.py)
 
     def update(
@@ -187,14 +198,17 @@ class ShoeObserver:
             self._start = self._time = estimate.time
         dt = estimate.time - self._time
         self._time = estimate.time
-        self._filter(np.array(pitch + speed + torque + push + load), dt)
+        slopes = self.slopes.update(estimate.time, boards)
+        grade = self.slopes.gravity_drag
+        pulls = [grade(a, self.shoe_mass, w) for a, w in zip(slopes, load, strict=True)]
+        self._filter(np.array(pitch + speed + torque + push + load + pulls), dt)
         f, p = self._filter, self.params
         assert f.y is not None
         y, dy, ddy = f.y.tolist(), f.dy.tolist(), f.ddy.tolist()
         theta, theta_dot, theta_ddot = y[:n], dy[:n], ddy[:n]
         accel = dy[n : 2 * n]
-        u, pushed, weight = y[2 * n : 3 * n], y[3 * n : 4 * n], y[4 * n :]
-        slopes = self.slopes.update(estimate.time, boards)
+        u, pushed, weight = y[2 * n : 3 * n], y[3 * n : 4 * n], y[4 * n : 5 * n]
+        pulled = y[5 * n :]  # the slope's pull as filtered as the speed it changes
         if estimate.time - self._start < self.warm_up:
             return
         forget = math.exp(-dt / self.memory)
@@ -203,10 +217,15 @@ class ShoeObserver:
             self._load[k] *= forget
             self._force[k] *= forget
             self._weight[k] *= forget
+            change = abs(slopes[k] - self._fitted_on[k])
+            if change > SLOPE_CHANGE:  # new ground: the drag fit forgets what it had
+                self._fitted_on[k] = slopes[k]
+                self._force[k] *= math.exp(-change / SLOPE_CHANGE)
+                self._weight[k] *= math.exp(-change / SLOPE_CHANGE)
             uphill = self.slopes.gravity_drag(slopes[k], self.shoe_mass, weight[k])
             if weight[k] > MIN_LOAD:
                 balance = p.J_theta * theta_ddot[k] + p.c2 * theta_dot[k] + p.c1 * theta[k] - u[k]
-                residual = self.shoe_mass * accel[k] - p.c4 * theta[k] - pushed[k] - uphill
+                residual = self.shoe_mass * accel[k] - p.c4 * theta[k] - pushed[k] - pulled[k]
                 self._moment[k] += weight[k] * balance
                 self._load[k] += weight[k] * weight[k]
                 self._force[k] += residual

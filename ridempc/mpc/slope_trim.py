@@ -16,11 +16,11 @@ estimated under the platforms (:mod:`ridempc.mpc.slope`) has been steeper than `
           \\delta = \\kappa\\,|\\sin\\hat\\alpha|, \\qquad |\\delta| \\le \\delta_{max},
 
 so that the trim :math:`\\delta` [m/s] moves at :math:`(v_{cmd} - v)/T` on a steady slope and
-goes with the slope where it ends (within the slope estimate's 0.3 s); on level ground it is
-zero. A speed error over ``BAND`` is a transient and is not integrated, nor one while the
-backup rides. The reference's speeds (the rider's and each platform's) are raised by
-:math:`\\delta` and its positions moved on by :math:`\\delta\\,t` over the horizon along the
-platforms' heading (:class:`SlopeTrim`, a problem shaper).
+goes with the slope where it ends (as the slope estimate reads level, within its window); on
+level ground it is zero. A speed error over ``BAND`` is a transient and is not integrated,
+nor one while the backup rides. The reference's speeds (the rider's and each platform's) are
+raised by :math:`\\delta` and its positions moved on by :math:`\\delta\\,t` over the horizon
+along the platforms' heading (:class:`SlopeTrim`, a problem shaper).
 """
 
 from __future__ import annotations
@@ -35,7 +35,6 @@ from numpy.typing import NDArray
 
 from ridempc.mpc.manoeuvre import MOVING, RETARGET_BAND, StateLayout
 from ridempc.mpc.problem import MpcProblem
-from ridempc.mpc.slope import TIME_CONSTANT as SLOPE_TIME
 
 if TYPE_CHECKING:  # the build's inputs carry the shoes' observer, which holds a trim
     from ridempc.mpc.stages.build import BuildInputs
@@ -47,9 +46,10 @@ Array = NDArray[np.float64]
 # [rad] 3 deg: ten times what the slope estimate reads on level ground (0.1-0.3 deg before
 # the crest of `slope-down-13`), a third of the gentlest slope a scenario rides (7 deg).
 GATE: float = math.radians(3.0)
-# [s] a slope is one the estimate has read beyond the gate for its own time constant: a step's
-# edge or a bump passes under it sooner (the estimate passes 3 deg for moments on level ground)
-HOLD: float = SLOPE_TIME
+# [s] a slope is one the estimate has read beyond the gate this long: a step's edge or a bump
+# passes under it sooner (the estimate passes 3 deg for moments on level ground); 0.3 s, the
+# time constant of the velocity-borne slope estimate this trim was measured with (session 10)
+HOLD: float = 0.3
 # [s] twice the rider's speed response (a 0.2 m/s step of the command is ridden within
 # 0.5 s: the library's 0.8 s per m/s plus its lean), so the trim does not ring with it;
 # short against the 6 s a ride spends on a 3 m slope.
