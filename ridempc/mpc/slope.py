@@ -42,12 +42,6 @@ from ridempc.gravity import GRAVITY
 
 __all__ = ["DROP_SPEED", "GRAVITY", "MAX_SLOPE", "SAMPLES", "WINDOW", "SlopeEstimator"]
 
-<<<<<<< HEAD
-# Below 0.15 m/s a centimetre-per-second error in the velocity tilts the estimate by 4 deg.
-MIN_SPEED: float = 0.15  # [m/s]
-=======
-GRAVITY: float = 9.81  # [m/s^2]
->>>>>>> h-slope
 # Steeper than any ramp a board is ridden on (the scenarios' steepest: 13 deg); a step's
 # drop passes through 30-80 deg for a tenth of a second.
 MAX_SLOPE: float = math.radians(25.0)  # [rad]
