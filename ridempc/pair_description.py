@@ -259,6 +259,11 @@ class FlightStage(_Frozen):
 class ImpulseStage(_Frozen):
     band: Speed = Field(description="Largest unexplained velocity change the MPC rides [m/s].")
     sideways: Speed | None = Field(default=None, description="The same across it [m/s].")
+    divergence_blend: bool = Field(
+        default=False,
+        description="A push's handover blended over the rider's divergence time, not the "
+        "handover's own blend (mpc/push_handover.py).",
+    )
 
 
 class Stages(_Frozen):

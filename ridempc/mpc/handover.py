@@ -256,6 +256,7 @@ class Handover:
         self._ticks = 0
         self._backup_command: MotorCommand | None = None
         self.blend_s = blend_s
+        self._blend_now = blend_s  # [s] the blend of the last switch
         self.dwell_s = dwell_s
         self.fallbacks: list[Fallback] = []
         self._switch_time: float | None = None  # [s] the last switch, either way
@@ -304,6 +305,7 @@ class Handover:
         failure: str | None,
         fit: bool,
         com_height: float | None = None,
+        blend_s: float | None = None,
     ) -> MotorCommand:
         """One tick: the backup updated, the handover decided, the command to send.
 
@@ -317,6 +319,8 @@ class Handover:
                 start: whether the primary is ready to take it.
             com_height: The centre of mass over the feet [m], for the start's window
                 (:meth:`fade_for`); None: not known.
+            blend_s: The blend [s] of a handover this tick (None: :attr:`blend_s`; a
+                push's, :func:`~ridempc.mpc.push_handover.push_blend`).
         """
         self._sent = self._step(sensors, command, primary, failure, fit, com_height)
         return self._sent
@@ -346,7 +350,7 @@ class Handover:
             start = self._sent
             fade_s = self.fade_for(now, com_height)
             self.fallbacks.append(Fallback(now, failure or "no command"))
-            self._switch(now, start if start is not None else backup)
+            self._switch(now, start if start is not None else backup, blend_s)
             self._fit_since = None
             if fade_s > 0.0:
                 joints = np.asarray(sensors.joint_position[: len(backup.position)], dtype=float)
@@ -393,15 +397,16 @@ class Handover:
             return command
         return self._fade(now, command)
 
-    def _switch(self, now: float, start: MotorCommand) -> None:
+    def _switch(self, now: float, start: MotorCommand, blend_s: float | None = None) -> None:
         self._switch_time, self._from = now, start
+        self._blend_now = self.blend_s if blend_s is None else blend_s
 
     def _blended(self, now: float, target: MotorCommand) -> MotorCommand:
-        """``target``, blended in from the last switch's command over :attr:`blend_s`."""
+        """``target``, blended in from the last switch's command over that switch's blend."""
         if self._switch_time is None or self._from is None:
             return target
         elapsed = now - self._switch_time + TIME_TOLERANCE
-        alpha = elapsed / self.blend_s if self.blend_s > 0.0 else 1.0
+        alpha = elapsed / self._blend_now if self._blend_now > 0.0 else 1.0
         if alpha >= 1.0:
             self._switch_time = self._from = None
             return target

@@ -21,15 +21,41 @@ while a re-push on a board slower than its stride's rolling start has a foot off
 *deviation* from the reference does not hand over; the MPC rides the stroke out and the
 deviation is judged again once every foot is back on the deck. A failed plan or an
 infeasible whole-body QP still hands over at once: the MPC then has nothing to ride with.
+
+**A push handed over is blended over the rider's divergence time** (:func:`push_blend`). A
+push from outside is ridden by moving the load between the legs: pushed to the left, the
+MPC rider (on its whole-body QP's feedforward torques and a tenth of the backup's joint
+stiffness) had put 82 N m on the left knee and 7 N m on the right by the impulse stage's
+handover, 0.16 s into the push (measured, Hovershoes `hard` seed 151 v0097). The backup
+balances with its own, nearly even, feedforward (50/40 N m) and a knee stiffness ten times
+the MPC's; switched within the usual blend (0.02 s, 10 ticks), the left knee lost 30 N m
+and the right gained 35 N m while their stiffness rose tenfold, the knees rang at ~30 Hz
+(+-10 rad/s, +-300 N m) and a foot struck the ground 0.32 s later, where the backup riding
+from the start stood the same push. The load a push has shifted is moved back no faster
+than the rider's lean grows, over
+
+.. math:: T_{blend} = 1/\\omega = \\sqrt{h/g}
+
+(:func:`~ridempc.mpc.handover.start_window`, ~0.3 s for Cassie's centre of mass 0.9 m over
+her feet), the MPC's command faded out and the backup's in over that time. A failed plan or
+QP is still blended out within the usual blend: its command cannot be trusted for longer.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 
+from ridempc.mpc.handover import start_window
 from ridempc.trajopt.schedule import Contact
 
-__all__ = ["deviation_deferred"]
+__all__ = ["deviation_deferred", "push_blend"]
+
+
+def push_blend(com_height: float | None, default: float) -> float:
+    """The blend [s] of a push's handover (see the module docstring): the rider's
+    divergence time with the centre of mass ``com_height`` [m] over the feet, or
+    ``default`` [s] (the handover's own) where that height is not known."""
+    return default if com_height is None else max(start_window(com_height), default)
 
 
 def deviation_deferred(

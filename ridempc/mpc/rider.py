@@ -62,7 +62,7 @@ from ridempc.mpc.handover import RETURN_DEVIATION
 from ridempc.mpc.manoeuvre import HOLD, REPUSH, REPUSH_BAND
 from ridempc.mpc.plan_solver import PROCESS_MIN_LATENCY
 from ridempc.mpc.platform_feet import platform_feet, rolling_platforms
-from ridempc.mpc.push_handover import deviation_deferred
+from ridempc.mpc.push_handover import deviation_deferred, push_blend
 from ridempc.mpc.rider_parts import BACKUP_LAW, MPC_DIVIDER
 from ridempc.mpc.rider_reports import RiderReports
 from ridempc.mpc.stages.base import ControlTick, MpcTick
@@ -168,7 +168,10 @@ class MpcRider(RiderReports):
         primary, failure = self._primary(sensors, command)
         self._tick += 1
         starting = self.handover.starting
-        out = self.handover.step(sensors, command, primary, failure, self._fit(), self._com_height)
+        pushed = self.push_watch is not None and self.push_watch.handed(failure)
+        blend_s = push_blend(self._com_height, self.handover.blend_s) if pushed else None
+        height = self._com_height
+        out = self.handover.step(sensors, command, primary, failure, self._fit(), height, blend_s)
         if starting and not self.handover.starting:  # its rate measured the backup's ride
             self.watch.divergence.reset()  # away from plans it did not follow
         self._diagnostics["on_backup"] = float(self.handover.on_backup)

@@ -138,10 +138,15 @@ class PushWatch:
     Args:
         observer: The impulse observer.
         trigger: The pair's impulse band.
+        divergence_blend: Whether its handover is blended over the rider's divergence time
+            (:func:`~ridempc.mpc.push_handover.push_blend`).
     """
 
-    def __init__(self, observer: ImpulseObserver, trigger: ImpulseTrigger) -> None:
+    def __init__(
+        self, observer: ImpulseObserver, trigger: ImpulseTrigger, divergence_blend: bool = False
+    ) -> None:
         self.observer, self._trigger = observer, trigger
+        self.divergence_blend = divergence_blend
         self.reason: str | None = None
 
     @classmethod
@@ -150,7 +155,8 @@ class PushWatch:
         [kg], as modelled; None without it."""
         if stage is None:
             return None
-        return cls(ImpulseObserver(mass), ImpulseTrigger(stage.band, stage.sideways))
+        trigger = ImpulseTrigger(stage.band, stage.sideways)
+        return cls(ImpulseObserver(mass), trigger, stage.divergence_blend)
 
     def observe(self, tick: ControlTick) -> None:
         if tick.on_backup:
@@ -168,6 +174,11 @@ class PushWatch:
     def __call__(self, check: HandoverCheck) -> str | None:
         """Why the push is beyond what the MPC rides, or None."""
         return self.reason
+
+    def handed(self, failure: str | None) -> bool:
+        """Whether ``failure`` (a tick's first reason) is this watch's push, to be blended
+        over the rider's divergence time."""
+        return self.divergence_blend and failure is not None and failure is self.reason
 
 
 def handover_triggers(
