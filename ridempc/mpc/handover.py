@@ -322,7 +322,7 @@ class Handover:
             blend_s: The blend [s] of a handover this tick (None: :attr:`blend_s`; a
                 push's, :func:`~ridempc.mpc.push_handover.push_blend`).
         """
-        self._sent = self._step(sensors, command, primary, failure, fit, com_height)
+        self._sent = self._step(sensors, command, primary, failure, fit, com_height, blend_s)
         return self._sent
 
     def _step(
@@ -333,6 +333,7 @@ class Handover:
         failure: str | None,
         fit: bool,
         com_height: float | None,
+        blend_s: float | None,
     ) -> MotorCommand:
         now = sensors.time
         self._start = now if self._start is None else self._start
