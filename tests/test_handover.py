@@ -73,21 +73,6 @@ def test_hands_over_at_the_first_failure_blended_and_back_after_the_dwell() -> N
     }
 
 
-def test_a_handover_blends_out_of_the_command_sent_not_the_unfit_ticks() -> None:
-    """The failing tick's own command (a plan solved from a state past the model's edge:
-    knee torques 200 N m off the last tick's on the Segway) never reaches the motors: the
-    blend starts from what they hold, so no field of the command steps at the handover."""
-    handover = Handover(_Backup())  # type: ignore[arg-type]
-    sent = []
-    for k in range(20):
-        sensors = SimpleNamespace(time=k * DT, joint_position=np.ones(3))
-        failure, primary = ("deviated", _command(-50.0)) if k == 10 else (None, _command(0.0))
-        sent.append(handover.step(sensors, None, primary, failure, False))  # type: ignore[arg-type]
-    torque = np.array([c.torque[0] for c in sent])
-    np.testing.assert_allclose(torque[:11], 0.0, atol=1e-6)  # the handover's tick: the last sent
-    assert np.all(np.diff(torque) >= 0.0) and np.all(np.diff(torque) <= DT / BLEND_S + 1e-9)
-
-
 def test_stays_on_the_backup_while_the_primary_is_unfit() -> None:
     handover = Handover(_Backup(), dwell_s=0.1)  # type: ignore[arg-type]
     _run(handover, 200, 0, range(10, 11), fit=False)

@@ -10,11 +10,7 @@ each further handover, :meth:`Handover.dwell`), at most :data:`RETURNS` times a 
 .. math:: u = (1 - \\alpha)\\, u_{from} + \\alpha\\, u_{to}, \\qquad
           \\alpha = \\min\\big(1, (t - t_{switch}) / T_{blend}\\big)
 
-over every field of the motor command (feedforward torque, targets and gains), where
-:math:`u_{from}` is the command the motors hold, the one sent the tick before: never the
-failing tick's own, which the triggers judged unfit (a plan solved from a state past the
-model's edge asks the Segway rider's knees for 100-225 N m off the tick before's, a kick
-that slides a foot on a low-friction deck). A backup
+over every field of the motor command (feedforward torque, targets and gains). A backup
 handed a rider in another posture than its own (the MPC twists the pelvis over the feet, or
 crouches) would pull every joint to its posture at once, its stiffness times the posture's
 error (0.25 rad of hip yaw at 300 N m/rad: 75 N m, which turns the shoes under the rider);
@@ -262,7 +258,7 @@ class Handover:
         self._switch_time: float | None = None  # [s] the last switch, either way
         self._from: MotorCommand | None = None  # the command blended out of since then
         self._fit_since: float | None = None
-        self._sent: MotorCommand | None = None  # the command step returned last: the motors'
+        self._last_primary: MotorCommand | None = None
         self.starting = False  # the backup holds the ride's start (start_on_backup)
         self.takeover_s: float | None = None  # [s] when the primary took the start's ride
         self._start: float | None = None  # [s] the ride's first tick
@@ -322,19 +318,6 @@ class Handover:
             blend_s: The blend [s] of a handover this tick (None: :attr:`blend_s`; a
                 push's, :func:`~ridempc.mpc.push_handover.push_blend`).
         """
-        self._sent = self._step(sensors, command, primary, failure, fit, com_height, blend_s)
-        return self._sent
-
-    def _step(
-        self,
-        sensors: SensorPacket,
-        command: Command,
-        primary: MotorCommand | None,
-        failure: str | None,
-        fit: bool,
-        com_height: float | None,
-        blend_s: float | None,
-    ) -> MotorCommand:
         now = sensors.time
         self._start = now if self._start is None else self._start
         backup = self._backup(sensors, command, primary is None or failure is not None)
@@ -342,13 +325,14 @@ class Handover:
             if failure is None and primary is not None and fit:
                 self.starting, self.takeover_s = False, now
                 self._switch(now, self._blended(now, backup))
+                self._last_primary = primary
                 return self._blended(now, primary)
             return self._blended(now, backup)
         if not self.on_backup:
             if failure is None and primary is not None:
+                self._last_primary = primary
                 return self._blended(now, primary)
-            # bumpless: out of what the motors hold, never the unfit tick's command
-            start = self._sent
+            start = primary if primary is not None else self._last_primary
             fade_s = self.fade_for(now, com_height)
             self.fallbacks.append(Fallback(now, failure or "no command"))
             self._switch(now, start if start is not None else backup, blend_s)
@@ -364,6 +348,7 @@ class Handover:
                 current.duration_s = now - current.time_s
                 self._switch(now, self._blended(now, self._faded(now, backup)))
                 self._fade = None
+                self._last_primary = primary
                 return self._blended(now, primary)
         else:
             self._fit_since = None
