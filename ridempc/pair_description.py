@@ -130,6 +130,11 @@ class MpcSection(_Frozen):
         description="The state's error, in its tolerances, beyond which the ride is handed to "
         "the PD (mpc/handover.py): the PD's basin; default the edge of the MPC's model.",
     )
+    handover_from_sent: Flag = Field(
+        default=False,
+        description="A handover blends out of the command sent the tick before, not the failing "
+        "tick's own (mpc/handover.py).",
+    )
     unrealised_inputs: tuple[str, ...] = Field(
         default=(), description="Board inputs the rider does not realise, held at zero."
     )

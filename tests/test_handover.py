@@ -279,3 +279,18 @@ def test_the_deviation_hands_over_inside_the_backups_basin() -> None:
     assert at(1.75) is None  # the library's largest: its manoeuvres ride on
     assert at(1.25 * 1.75) is None
     assert at(2.9) is not None  # at 3.0 the handed PD stood in 4 rides of 18: before that
+
+
+def test_a_handover_from_sent_blends_out_of_the_command_sent_not_the_unfit_ticks() -> None:
+    """With ``from_sent`` the failing tick's own command (a plan solved from a state past the
+    model's edge: knee torques 200 N m off the last tick's on the Segway) never reaches the
+    motors: the blend starts from what they hold, so no field of the command steps."""
+    handover = Handover(_Backup(), from_sent=True)  # type: ignore[arg-type]
+    sent = []
+    for k in range(20):
+        sensors = SimpleNamespace(time=k * DT, joint_position=np.ones(3))
+        failure, primary = ("deviated", _command(-50.0)) if k == 10 else (None, _command(0.0))
+        sent.append(handover.step(sensors, None, primary, failure, False))  # type: ignore[arg-type]
+    torque = np.array([c.torque[0] for c in sent])
+    np.testing.assert_allclose(torque[:11], 0.0, atol=1e-6)  # the handover's tick: the last sent
+    assert np.all(np.diff(torque) >= 0.0) and np.all(np.diff(torque) <= DT / BLEND_S + 1e-9)

@@ -228,6 +228,11 @@ class Handover:
             a period, ``standby_every // 2``; :func:`~ridempc.mpc.stagger.standby_phase`).
         fade_s: :math:`T_{fade}` [s] (0: none); none in a start's first divergence time
             (:meth:`fade_for`).
+        from_sent: Blend a handover out of the command sent the tick before, not out of the
+            failing tick's own (which the triggers judged unfit: on the Segway a plan solved
+            past the model's edge asks the knees for 100-225 N m off the tick before's, a kick
+            that slides both feet on the one deck they share, where the handed PD, with no
+            sensor of where its feet stand on the deck, cannot put them back).
 
     Attributes:
         fallbacks: Every handover so far, in order.
@@ -242,8 +247,11 @@ class Handover:
         standby_phase: int | None = None,
         fade_s: float = POSTURE_FADE_S,
         returns: int = RETURNS,
+        from_sent: bool = False,
     ) -> None:
         self.backup = backup
+        self.from_sent = from_sent
+        self._sent: MotorCommand | None = None  # the command step returned last: the motors'
         self.returns = returns
         self.fade_s = fade_s
         self._fade: PostureFade | None = None  # the posture's offset at the last handover
@@ -303,6 +311,21 @@ class Handover:
         com_height: float | None = None,
         blend_s: float | None = None,
     ) -> MotorCommand:
+        """One tick (:meth:`_step`), the command sent kept for the next handover's blend
+        (``from_sent``)."""
+        self._sent = self._step(sensors, command, primary, failure, fit, com_height, blend_s)
+        return self._sent
+
+    def _step(
+        self,
+        sensors: SensorPacket,
+        command: Command,
+        primary: MotorCommand | None,
+        failure: str | None,
+        fit: bool,
+        com_height: float | None = None,
+        blend_s: float | None = None,
+    ) -> MotorCommand:
         """One tick: the backup updated, the handover decided, the command to send.
 
         Args:
@@ -333,6 +356,8 @@ class Handover:
                 self._last_primary = primary
                 return self._blended(now, primary)
             start = primary if primary is not None else self._last_primary
+            if self.from_sent and self._sent is not None:
+                start = self._sent  # what the motors hold, never the unfit tick's command
             fade_s = self.fade_for(now, com_height)
             self.fallbacks.append(Fallback(now, failure or "no command"))
             self._switch(now, start if start is not None else backup, blend_s)

@@ -264,6 +264,7 @@ class RiderParts(Controller):
             law,
             standby_every=1,
             standby_phase=standby_phase(MPC_DIVIDER, latency),  # off the MPC's and plan's ticks
+            from_sent=self.pair.description.mpc.handover_from_sent,
         )
         # the ride starts on the backup until the MPC is ready (mpc/readiness.py)
         self.readiness = start_readiness(stages.takeover, RETURN_DWELL_S)
