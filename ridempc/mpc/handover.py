@@ -251,7 +251,7 @@ class Handover:
     ) -> None:
         self.backup = backup
         self.from_sent = from_sent
-        self._sent: MotorCommand | None = None  # the command step returned last: the motors'
+        self._sent: MotorCommand | None = None  # what step returned last: the motors' command
         self.returns = returns
         self.fade_s = fade_s
         self._fade: PostureFade | None = None  # the posture's offset at the last handover
@@ -311,22 +311,8 @@ class Handover:
         com_height: float | None = None,
         blend_s: float | None = None,
     ) -> MotorCommand:
-        """One tick (:meth:`_step`), the command sent kept for the next handover's blend
-        (``from_sent``)."""
-        self._sent = self._step(sensors, command, primary, failure, fit, com_height, blend_s)
-        return self._sent
-
-    def _step(
-        self,
-        sensors: SensorPacket,
-        command: Command,
-        primary: MotorCommand | None,
-        failure: str | None,
-        fit: bool,
-        com_height: float | None = None,
-        blend_s: float | None = None,
-    ) -> MotorCommand:
-        """One tick: the backup updated, the handover decided, the command to send.
+        """One tick: the backup updated, the handover decided, the command to send, kept
+        for the next handover's blend (``from_sent``).
 
         Args:
             sensors: This tick's packet (for the backup).
@@ -341,6 +327,20 @@ class Handover:
             blend_s: The blend [s] of a handover this tick (None: :attr:`blend_s`; a
                 push's, :func:`~ridempc.mpc.push_handover.push_blend`).
         """
+        self._sent = self._step(sensors, command, primary, failure, fit, com_height, blend_s)
+        return self._sent
+
+    def _step(
+        self,
+        sensors: SensorPacket,
+        command: Command,
+        primary: MotorCommand | None,
+        failure: str | None,
+        fit: bool,
+        com_height: float | None,
+        blend_s: float | None,
+    ) -> MotorCommand:
+        """:meth:`step`'s decision, every return path of it."""
         now = sensors.time
         self._start = now if self._start is None else self._start
         backup = self._backup(sensors, command, primary is None or failure is not None)
